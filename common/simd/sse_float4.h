@@ -1,0 +1,78 @@
+#pragma once
+// Thin, explicit wrapper over SSE4.1 intrinsics: four float lanes (F4) and a
+// lane mask (M4). Only the SSE twins include this; the scalar twins are plain
+// C++. Every operation maps to one or two instructions, so the kernels read as
+// arithmetic while the generated code stays predictable.
+
+#include <smmintrin.h>
+
+#include "common/float4.h"
+
+namespace fishtank::simd {
+
+struct M4 {
+  __m128 v;
+};
+
+struct F4 {
+  __m128 v;
+
+  static F4 splat(float s) { return {_mm_set1_ps(s)}; }
+  static F4 zero() { return {_mm_setzero_ps()}; }
+  static F4 load(const Float4& f) { return {_mm_load_ps(&f.x)}; }
+  static F4 set(float x, float y, float z, float w) { return {_mm_setr_ps(x, y, z, w)}; }
+  void store(Float4& f) const { _mm_store_ps(&f.x, v); }
+};
+
+inline F4 operator+(F4 a, F4 b) { return {_mm_add_ps(a.v, b.v)}; }
+inline F4 operator-(F4 a, F4 b) { return {_mm_sub_ps(a.v, b.v)}; }
+inline F4 operator*(F4 a, F4 b) { return {_mm_mul_ps(a.v, b.v)}; }
+inline F4 operator/(F4 a, F4 b) { return {_mm_div_ps(a.v, b.v)}; }
+inline F4& operator+=(F4& a, F4 b) { return a = a + b; }
+inline F4 sqrt(F4 a) { return {_mm_sqrt_ps(a.v)}; }
+inline F4 max(F4 a, F4 b) { return {_mm_max_ps(a.v, b.v)}; }
+inline F4 min(F4 a, F4 b) { return {_mm_min_ps(a.v, b.v)}; }
+inline M4 operator<(F4 a, F4 b) { return {_mm_cmplt_ps(a.v, b.v)}; }
+inline M4 operator>(F4 a, F4 b) { return {_mm_cmpgt_ps(a.v, b.v)}; }
+inline bool any(M4 m) { return _mm_movemask_ps(m.v) != 0; }
+// Lanes where the mask is off become zero.
+inline F4 keep(M4 m, F4 a) { return {_mm_and_ps(m.v, a.v)}; }
+
+// Zero the w lane.
+inline F4 xyz_only(F4 a) { return {_mm_blend_ps(a.v, _mm_setzero_ps(), 0b1000)}; }
+
+// Dot product of the x, y, z lanes, broadcast to all four lanes.
+inline F4 dot3(F4 a, F4 b) { return {_mm_dp_ps(a.v, b.v, 0x7F)}; }
+
+// Lane L of a, broadcast to all four lanes.
+template <int L>
+inline F4 broadcast(F4 a) {
+  return {_mm_shuffle_ps(a.v, a.v, _MM_SHUFFLE(L, L, L, L))};
+}
+
+// Rows a,b,c,d (each x,y,z,w) become columns: xs, ys, zs, ws of the four.
+inline void transpose(F4 a, F4 b, F4 c, F4 d, F4& xs, F4& ys, F4& zs, F4& ws) {
+  __m128 t0 = _mm_unpacklo_ps(a.v, b.v);  // ax bx ay by
+  __m128 t1 = _mm_unpacklo_ps(c.v, d.v);  // cx dx cy dy
+  __m128 t2 = _mm_unpackhi_ps(a.v, b.v);  // az bz aw bw
+  __m128 t3 = _mm_unpackhi_ps(c.v, d.v);  // cz dz cw dw
+  xs.v = _mm_movelh_ps(t0, t1);
+  ys.v = _mm_movehl_ps(t1, t0);
+  zs.v = _mm_movelh_ps(t2, t3);
+  ws.v = _mm_movehl_ps(t3, t2);
+}
+
+// Sum of the four lanes of each input, packed as (sum x, sum y, sum z, 0).
+inline F4 sum_lanes_xyz(F4 xs, F4 ys, F4 zs) {
+  __m128 t0 = _mm_hadd_ps(xs.v, ys.v);              // x01 x23 y01 y23
+  __m128 t1 = _mm_hadd_ps(zs.v, _mm_setzero_ps());  // z01 z23 0 0
+  return {_mm_hadd_ps(t0, t1)};                     // x y z 0
+}
+
+inline float lane(F4 a, int i) {
+  alignas(16) float f[4];
+  _mm_store_ps(f, a.v);
+  return f[i];
+}
+
+}  // namespace fishtank::simd

@@ -1,0 +1,23 @@
+#pragma once
+// Headless benchmark: build a scene, let it settle, time unpaced steps, and
+// describe the run as one JSON object.
+
+#include <cstdint>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "server/bench/scenes.h"
+#include "server/physics/world.h"
+
+namespace fishtank {
+
+struct BenchSpec {
+  SceneSpec scene;
+  std::uint64_t steps = 2000;
+};
+
+// Runs the timed part on an already settled world and returns the report.
+nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleReport& settle);
+
+}  // namespace fishtank

@@ -1,0 +1,111 @@
+#include "server/options.h"
+
+#include <cmath>
+#include <sstream>
+
+#include <boost/program_options.hpp>
+
+#include "server/bench/scenes.h"
+#include "server/physics/worker_pool.h"
+
+namespace fishtank {
+
+namespace po = boost::program_options;
+
+ParseResult parse_server_options(int argc, const char* const argv[], const char* variant, bool threaded) {
+  ServerOptions o;
+  PhysicsParams defaults;
+  std::int64_t balls = -1, start_balls = o.start_balls, steps = static_cast<std::int64_t>(o.bench_spec.steps);
+  std::int64_t threads = threaded ? WorkerPool::hardware_threads() : 1, max_balls = 0, seed = 1;
+  std::int64_t steps_per_contact = defaults.steps_per_contact;
+  double settle_time = 0.0;
+
+  po::options_description general("General");
+  general.add_options()("help,h", "print this help and exit")(
+      "threads", po::value(&threads)->default_value(threads),
+      threaded ? "worker threads (default: the cores available now)" : "worker threads (the scalar build uses 1)")(
+      "seed", po::value(&seed)->default_value(seed), "random seed for spawning, >= 0")(
+      "balls", po::value(&balls),
+      "balls to pour in at start (default 1000; with --bench, 6000)")(
+      "max-balls", po::value(&max_balls)->default_value(0), "most balls the tank may hold (0: its capacity, ~6100)")(
+      "duration", po::value(&o.duration)->default_value(0.0), "stop after this many seconds (0: run until Ctrl-C)")(
+      "status-interval", po::value(&o.status_interval)->default_value(1.0), "seconds between status lines")(
+      "dump", po::value(&o.dump_path), "write the final state as CSV (x,y,z,vx,vy,vz,diameter,mass)");
+
+  po::options_description physics("Physics");
+  physics.add_options()("stiffness", po::value(&o.physics.stiffness)->default_value(defaults.stiffness),
+                        "contact spring constant k, N/m")(
+      "restitution", po::value(&o.physics.restitution)->default_value(defaults.restitution),
+      "coefficient of restitution e, (0, 1]")(
+      "steps-per-contact", po::value(&steps_per_contact)->default_value(steps_per_contact),
+      "automatic dt = contact duration / this (>= 10)")(
+      "dt", po::value(&o.physics.dt)->default_value(0.0), "fixed time step in seconds (0: automatic)")(
+      "skin", po::value(&o.physics.skin)->default_value(defaults.skin), "neighbour-list skin, units");
+
+  po::options_description bench("Benchmark");
+  bench.add_options()("bench", po::bool_switch(&o.bench), "run unpaced without network and print one JSON object")(
+      "scene", po::value(&o.bench_spec.scene.name)->default_value("tank"), "benchmark scene: tank or wide")(
+      "steps", po::value(&steps)->default_value(steps), "timed steps after settling")(
+      "settle-time", po::value(&settle_time)->default_value(0.0),
+      "most simulated seconds to wait for rest (0: 90 for tank, 4 for wide)");
+
+  po::options_description all;
+  all.add(general).add(physics).add(bench);
+
+  ParseResult result;
+  std::ostringstream help;
+  help << "fishtank-server (" << variant << " variant): granular physics of balls in a fish tank.\n\n"
+       << "Usage: fishtank-server [options]\n"
+       << "       fishtank-server --bench [--scene tank|wide] [--balls N] [--steps S] [--threads T]\n"
+       << all;
+  po::variables_map vm;
+  try {
+    po::store(po::parse_command_line(argc, argv, all), vm);
+    po::notify(vm);
+  } catch (const po::error& e) {
+    result.exit_code = 2;
+    result.message = std::string("fishtank-server: ") + e.what() + "\nTry --help for the list of options.";
+    return result;
+  }
+  if (vm.count("help")) {
+    result.message = help.str();
+    return result;
+  }
+
+  auto fail = [&result](const std::string& why) {
+    result.exit_code = 2;
+    result.message = "fishtank-server: " + why;
+    return result;
+  };
+  if (balls == -1) balls = o.bench ? 6000 : start_balls;
+  if (balls < 0 || balls > 10'000'000) return fail("--balls must be between 0 and 10000000, got " + std::to_string(balls));
+  if (threads < 1 || threads > 1024) return fail("--threads must be between 1 and 1024, got " + std::to_string(threads));
+  if (!threaded && threads != 1) return fail("the scalar build runs on one thread; drop --threads or use fishtank-server");
+  if (seed < 0) return fail("--seed must be >= 0");
+  if (steps < 1 || steps > 1'000'000'000) return fail("--steps must be between 1 and 1e9, got " + std::to_string(steps));
+  if (max_balls < 0 || max_balls > 10'000'000) return fail("--max-balls must be between 0 and 10000000");
+  if (!std::isfinite(o.duration) || o.duration < 0.0) return fail("--duration must be a number of seconds >= 0");
+  if (!std::isfinite(o.status_interval) || o.status_interval < 0.05 || o.status_interval > 3600.0)
+    return fail("--status-interval must be between 0.05 and 3600 seconds");
+  if (!std::isfinite(settle_time) || settle_time < 0.0 || settle_time > 1e6)
+    return fail("--settle-time must be between 0 and 1e6 simulated seconds");
+  if (!is_known_scene(o.bench_spec.scene.name))
+    return fail("unknown scene '" + o.bench_spec.scene.name + "'; the scenes are tank and wide");
+  if (steps_per_contact < 1 || steps_per_contact > 100000)
+    return fail("--steps-per-contact must be between 10 and 100000, got " + std::to_string(steps_per_contact));
+
+  o.physics.steps_per_contact = static_cast<int>(steps_per_contact);
+  o.threads = static_cast<int>(threads);
+  o.start_balls = static_cast<std::uint32_t>(balls);
+  o.max_balls = static_cast<std::uint32_t>(max_balls);
+  o.bench_spec.scene.balls = o.start_balls;
+  o.bench_spec.scene.seed = static_cast<std::uint64_t>(seed);
+  o.bench_spec.scene.max_settle_seconds = settle_time;
+  o.bench_spec.steps = static_cast<std::uint64_t>(steps);
+  if (o.bench) o.physics.tank = scene_tank(o.bench_spec.scene);
+  if (std::string why = validate(o.physics); !why.empty()) return fail(why);
+  result.options = o;
+  return result;
+}
+
+}  // namespace fishtank

@@ -1,0 +1,34 @@
+#pragma once
+// Command-line flags of fishtank-server: parsing, defaults and validation.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "server/bench/benchmark.h"
+#include "server/physics/params.h"
+
+namespace fishtank {
+
+struct ServerOptions {
+  bool bench = false;
+  BenchSpec bench_spec;
+  int threads = 1;
+  std::uint32_t start_balls = 1000;
+  std::uint32_t max_balls = 0;  // 0: the tank's capacity
+  double duration = 0.0;        // seconds of real time; 0: until interrupted
+  double status_interval = 1.0;
+  std::string dump_path;
+  PhysicsParams physics;
+};
+
+struct ParseResult {
+  std::optional<ServerOptions> options;  // empty: exit with exit_code after printing message
+  int exit_code = 0;
+  std::string message;
+};
+
+// variant and threaded describe the build, for --help and the threads default.
+ParseResult parse_server_options(int argc, const char* const argv[], const char* variant, bool threaded);
+
+}  // namespace fishtank

@@ -1,0 +1,91 @@
+#include "server/physics/broadphase.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "server/physics/kernels.h"
+
+namespace fishtank {
+
+void NeighbourList::configure(const TankBounds& tank, float skin) {
+  tank_ = tank;
+  skin_ = skin;
+  const float min_edge = kMaxBallDiameter + skin;
+  Vec3 size = tank.size();
+  nx_ = std::max(1, static_cast<int>(size.x / min_edge));
+  ny_ = std::max(1, static_cast<int>(size.y / min_edge));
+  nz_ = std::max(1, static_cast<int>(size.z / min_edge));
+  inv_edge_ = {nx_ / size.x, ny_ / size.y, nz_ / size.z};
+  cell_start_.assign(std::size_t(nx_) * ny_ * nz_ + 1, 0);
+}
+
+std::uint32_t NeighbourList::cell_of(const Float4& p) const {
+  // fmin/fmax also send NaN to a valid cell; balls pushed outside the tank go
+  // to the border cell, which still finds all their neighbours.
+  auto axis = [](float pos, float lo, float inv_edge, int cells) {
+    float c = std::floor((pos - lo) * inv_edge);
+    return static_cast<std::uint32_t>(std::fmin(std::fmax(c, 0.0f), float(cells - 1)));
+  };
+  std::uint32_t cx = axis(p.x, tank_.min.x, inv_edge_.x, nx_);
+  std::uint32_t cy = axis(p.y, tank_.min.y, inv_edge_.y, ny_);
+  std::uint32_t cz = axis(p.z, tank_.min.z, inv_edge_.z, nz_);
+  return cx + std::uint32_t(nx_) * (cy + std::uint32_t(ny_) * cz);
+}
+
+void NeighbourList::sort(const Float4* pos, std::uint32_t n, std::vector<std::uint32_t>& order) {
+  scratch_cell_.resize(n);
+  std::fill(cell_start_.begin(), cell_start_.end(), 0u);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    scratch_cell_[i] = cell_of(pos[i]);
+    ++cell_start_[scratch_cell_[i] + 1];
+  }
+  for (std::size_t c = 1; c < cell_start_.size(); ++c) cell_start_[c] += cell_start_[c - 1];
+
+  order.resize(n);
+  sorted_cell_.resize(n);
+  std::vector<std::uint32_t> next(cell_start_.begin(), cell_start_.end() - 1);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    std::uint32_t slot = next[scratch_cell_[i]]++;
+    order[slot] = i;
+    sorted_cell_[slot] = scratch_cell_[i];
+  }
+}
+
+void NeighbourList::reserve(std::uint32_t n, std::uint32_t stride) {
+  stride_ = padded_neighbour_count(std::max(stride, 4u));
+  neighbours_.resize(std::size_t(n) * stride_);
+  counts_.resize(n);
+}
+
+std::uint32_t NeighbourList::build(const Float4* pos, std::uint32_t n, std::uint32_t begin, std::uint32_t end) {
+  const std::uint32_t ghost = n;  // the world keeps a far-away ball at index n
+  std::uint32_t longest = 0;
+  for (std::uint32_t i = begin; i < end; ++i) {
+    const Float4 pi = pos[i];
+    const int cell = static_cast<int>(sorted_cell_[i]);
+    const int cx = cell % nx_, cy = (cell / nx_) % ny_, cz = cell / (nx_ * ny_);
+    const int x_lo = std::max(cx - 1, 0), x_hi = std::min(cx + 1, nx_ - 1);
+    std::uint32_t* list = neighbours_.data() + std::size_t(i) * stride_;
+    std::uint32_t count = 0;
+    for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, nz_ - 1); ++z) {
+      for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, ny_ - 1); ++y) {
+        const std::size_t row = std::size_t(nx_) * (y + std::size_t(ny_) * z);
+        const std::uint32_t j_end = cell_start_[row + x_hi + 1];
+        for (std::uint32_t j = cell_start_[row + x_lo]; j < j_end; ++j) {
+          const Float4& pj = pos[j];
+          float dx = pi.x - pj.x, dy = pi.y - pj.y, dz = pi.z - pj.z;
+          float cutoff = pi.w + pj.w + skin_;
+          if (dx * dx + dy * dy + dz * dz >= cutoff * cutoff || j == i) continue;
+          if (count < stride_) list[count] = j;
+          ++count;
+        }
+      }
+    }
+    counts_[i] = count;
+    for (std::uint32_t pad = count; pad < std::min(padded_neighbour_count(count), stride_); ++pad) list[pad] = ghost;
+    longest = std::max(longest, count);
+  }
+  return longest;
+}
+
+}  // namespace fishtank

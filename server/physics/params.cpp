@@ -1,0 +1,73 @@
+#include "server/physics/params.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace fishtank {
+
+namespace {
+constexpr float kPi = 3.14159265358979f;
+}
+
+float damping_ratio(float restitution) {
+  float ln_e = std::log(restitution);
+  return -ln_e / std::sqrt(kPi * kPi + ln_e * ln_e);
+}
+
+float smallest_effective_mass() {
+  float lightest = kBallKinds[0].mass;
+  for (const BallKind& kind : kBallKinds) lightest = std::min(lightest, kind.mass);
+  return lightest * lightest / (lightest + lightest);
+}
+
+float contact_duration(float stiffness) {
+  return kPi * std::sqrt(smallest_effective_mass() / stiffness);
+}
+
+float derived_dt(const PhysicsParams& p) {
+  return p.dt > 0.0f ? p.dt : contact_duration(p.stiffness) / static_cast<float>(p.steps_per_contact);
+}
+
+std::string validate(const PhysicsParams& p) {
+  std::ostringstream err;
+  if (!std::isfinite(p.stiffness) || p.stiffness <= 0.0f || p.stiffness > 1.0e9f)
+    err << "stiffness k must be in (0, 1e9] N/m, got " << p.stiffness;
+  else if (!std::isfinite(p.restitution) || p.restitution <= 0.0f || p.restitution > 1.0f)
+    err << "restitution e must be in (0, 1], got " << p.restitution;
+  else if (p.steps_per_contact < PhysicsParams::kMinStepsPerContact || p.steps_per_contact > 100000)
+    err << "steps per contact must be in [" << PhysicsParams::kMinStepsPerContact
+        << ", 100000], got " << p.steps_per_contact;
+  else if (!std::isfinite(p.dt) || p.dt < 0.0f)
+    err << "dt must be a positive number of seconds (or 0 for automatic), got " << p.dt;
+  else if (p.dt > contact_duration(p.stiffness) / PhysicsParams::kMinStepsPerContact)
+    err << "dt = " << p.dt << " s is unstable for k = " << p.stiffness << " N/m: a contact lasts t_c = "
+        << contact_duration(p.stiffness) << " s and needs at least " << PhysicsParams::kMinStepsPerContact
+        << " steps, so dt must be <= " << contact_duration(p.stiffness) / PhysicsParams::kMinStepsPerContact
+        << " s (automatic: " << contact_duration(p.stiffness) / p.steps_per_contact << " s)";
+  else if (!std::isfinite(p.skin) || p.skin <= 0.0f || p.skin > 10.0f)
+    err << "neighbour skin must be in (0, 10] units, got " << p.skin;
+  else if (!std::isfinite(p.gravity) || std::fabs(p.gravity) > 1000.0f)
+    err << "gravity must be in [-1000, 1000] m/s^2, got " << p.gravity;
+  else if (!std::isfinite(p.player_max_speed) || p.player_max_speed < 0.0f || p.player_max_speed > 100.0f)
+    err << "player max speed must be in [0, 100] m/s, got " << p.player_max_speed;
+  else {
+    Vec3 s = p.tank.size();
+    if (!is_finite(s) || s.x < 4.0f || s.y < 4.0f || s.z < 4.0f || s.x > 1.0e5f || s.z > 1.0e5f || s.y > 1.0e5f)
+      err << "tank must be between 4 and 1e5 units on each side";
+  }
+  return err.str();
+}
+
+ContactModel make_contact_model(const PhysicsParams& p) {
+  ContactModel m;
+  m.k = p.stiffness;
+  m.damping_factor = 2.0f * damping_ratio(p.restitution) * std::sqrt(p.stiffness);
+  m.dt = derived_dt(p);
+  m.half_dt = 0.5f * m.dt;
+  m.gravity = p.gravity;
+  m.tank = p.tank;
+  return m;
+}
+
+}  // namespace fishtank

@@ -1,0 +1,51 @@
+#pragma once
+// Contact-model and time-step parameters, and the rules that derive one from
+// another (documented in docs/technical-report.md, "Time step from stiffness").
+//
+//   damping ratio    zeta = -ln e / sqrt(pi^2 + ln^2 e)
+//   pair damping     c    = 2 zeta sqrt(k m_eff),   m_eff = m1 m2 / (m1 + m2)
+//   contact duration t_c  = pi sqrt(m_eff,min / k)   (undamped half period)
+//   time step        dt   = t_c / steps_per_contact
+
+#include <string>
+
+#include "common/tank.h"
+
+namespace fishtank {
+
+struct PhysicsParams {
+  float stiffness = 2.0e4f;      // k, N/m: keeps a full tank's overlap a few % of r_min
+  float restitution = 0.6f;      // e, measured rebound / approach normal speed
+  int steps_per_contact = 20;    // n in dt = t_c / n
+  float dt = 0.0f;               // 0: derive from k; otherwise must be <= t_c / kMinStepsPerContact
+  float skin = 0.3f;             // neighbour-list skin, units
+  float gravity = 9.81f;         // m/s^2, along -y
+  float player_max_speed = 10.0f;  // m/s; faster commands are clamped
+  TankBounds tank;
+
+  static constexpr int kMinStepsPerContact = 10;
+};
+
+// Everything the kernels need, derived once from PhysicsParams.
+struct ContactModel {
+  float k;
+  float damping_factor;  // 2 zeta sqrt(k): c = damping_factor * sqrt(m_eff)
+  float dt;
+  float half_dt;
+  float gravity;
+  TankBounds tank;
+};
+
+float damping_ratio(float restitution);
+float smallest_effective_mass();
+float contact_duration(float stiffness);
+float derived_dt(const PhysicsParams& p);
+
+// Empty when the parameters are usable; otherwise a message that says which
+// value is wrong and what would be accepted.
+std::string validate(const PhysicsParams& p);
+
+// Requires validate(p) to be empty.
+ContactModel make_contact_model(const PhysicsParams& p);
+
+}  // namespace fishtank

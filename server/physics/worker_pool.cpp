@@ -1,0 +1,85 @@
+#include "server/physics/worker_pool.h"
+
+#include <algorithm>
+
+#include <immintrin.h>
+
+#include "common/fp_env.h"
+
+namespace fishtank {
+
+namespace {
+// About 20-50 microseconds of polling before a worker goes to sleep.
+constexpr int kSpinIterations = 20000;
+}  // namespace
+
+int WorkerPool::hardware_threads() {
+  return std::max(1u, boost::thread::hardware_concurrency());
+}
+
+WorkerPool::WorkerPool(int threads) : thread_count_(std::max(1, threads)) {
+  for (int t = 1; t < thread_count_; ++t) workers_.emplace_back([this, t] { worker_loop(t); });
+}
+
+WorkerPool::~WorkerPool() {
+  {
+    boost::lock_guard<boost::mutex> lock(mutex_);
+    stopping_ = true;
+    generation_.fetch_add(1);
+  }
+  wake_.notify_all();
+  for (boost::thread& w : workers_) w.join();
+}
+
+void WorkerPool::run_chunk(int thread) {
+  std::uint64_t n = count_;
+  auto begin = static_cast<std::uint32_t>(n * thread / thread_count_);
+  auto end = static_cast<std::uint32_t>(n * (thread + 1) / thread_count_);
+  if (begin < end) (*phase_)(begin, end, thread);
+}
+
+void WorkerPool::run(std::uint32_t count, const Phase& phase) {
+  if (thread_count_ == 1) {
+    if (count > 0) phase(0, count, 0);
+    return;
+  }
+  phase_ = &phase;
+  count_ = count;
+  pending_.store(thread_count_ - 1, std::memory_order_relaxed);
+  {
+    // Taking the lock orders the publish against a worker that is about to sleep.
+    boost::lock_guard<boost::mutex> lock(mutex_);
+    generation_.fetch_add(1, std::memory_order_release);
+  }
+  wake_.notify_all();
+  run_chunk(0);
+  // Yield once the other threads are late, so an oversubscribed machine still progresses.
+  for (int spins = 0; pending_.load(std::memory_order_acquire) != 0; ++spins) {
+    if (spins < kSpinIterations)
+      _mm_pause();
+    else
+      boost::this_thread::yield();
+  }
+}
+
+void WorkerPool::worker_loop(int thread) {
+  enable_flush_denormals_to_zero();
+  std::uint64_t seen = 0;
+  for (;;) {
+    int spins = 0;
+    while (generation_.load(std::memory_order_acquire) == seen && spins < kSpinIterations) {
+      _mm_pause();
+      ++spins;
+    }
+    if (generation_.load(std::memory_order_acquire) == seen) {
+      boost::unique_lock<boost::mutex> lock(mutex_);
+      wake_.wait(lock, [&] { return generation_.load(std::memory_order_acquire) != seen; });
+    }
+    seen = generation_.load(std::memory_order_acquire);
+    if (stopping_.load()) return;
+    run_chunk(thread);
+    pending_.fetch_sub(1, std::memory_order_release);
+  }
+}
+
+}  // namespace fishtank

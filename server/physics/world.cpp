@@ -1,0 +1,322 @@
+#include "server/physics/world.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "common/fp_env.h"
+
+namespace fishtank {
+
+namespace {
+
+constexpr float kPackingLimit = 0.6f;
+constexpr Float4 kGhostPos{1e6f, 1e6f, 1e6f, 0.0f};
+constexpr Float4 kGhostVel{0.0f, 0.0f, 0.0f, 1.0f};
+
+class PhaseTimer {
+ public:
+  explicit PhaseTimer(double& total) : total_(total), start_(std::chrono::steady_clock::now()) {}
+  ~PhaseTimer() { total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+
+ private:
+  double& total_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+template <class Vector>
+void apply_order(Vector& v, const std::vector<std::uint32_t>& order, Vector& scratch) {
+  scratch.resize(v.size());
+  for (std::size_t k = 0; k < order.size(); ++k) scratch[k] = v[order[k]];
+  for (std::size_t k = order.size(); k < v.size(); ++k) scratch[k] = v[k];
+  v.swap(scratch);
+}
+
+}  // namespace
+
+World::World(const PhysicsParams& params, const Kernels& kernels, int threads, std::uint64_t seed)
+    : params_(params),
+      model_(make_contact_model(params)),
+      kernels_(kernels),
+      pool_(kernels.threaded ? threads : 1),
+      spawner_(params.tank, seed) {
+  enable_flush_denormals_to_zero();
+  list_.configure(params.tank, params.skin);
+  capacity_ = static_cast<std::uint32_t>(kPackingLimit * params.tank.volume() / mean_ball_volume());
+  max_balls_ = capacity_;
+  thread_max_d2_.resize(pool_.threads());
+  thread_longest_.resize(pool_.threads());
+  resize(0);
+}
+
+void World::resize(std::uint32_t n) {
+  n_ = n;
+  for (auto* v : {&pos_, &vel_, &vel_half_, &acc_, &pos_at_build_}) v->resize(n + 1);
+  kind_.resize(n);
+  id_.resize(n);
+  set_ghost();
+}
+
+void World::set_ghost() {
+  pos_[n_] = pos_at_build_[n_] = kGhostPos;
+  vel_[n_] = vel_half_[n_] = kGhostVel;
+  acc_[n_] = Float4{};
+}
+
+AddResult World::add_balls(std::int64_t count) {
+  AddResult result;
+  const std::int64_t room = std::max<std::int64_t>(0, std::int64_t(max_balls_) - n_ - spawner_.pending());
+  if (count <= 0) {
+    result.refusal = "asked to add " + std::to_string(count) + " balls; the count must be positive";
+    return result;
+  }
+  result.accepted = static_cast<std::uint32_t>(std::min(count, room));
+  spawner_.enqueue(result.accepted);
+  if (result.accepted < count)
+    result.refusal = "added " + std::to_string(result.accepted) + " of " + std::to_string(count) +
+                     " balls: the tank holds at most " + std::to_string(max_balls_) + " (" + std::to_string(n_) +
+                     " in it, " + std::to_string(spawner_.pending() - result.accepted) + " already queued)";
+  return result;
+}
+
+void World::place_ball(int kind, Vec3 p, Vec3 v) {
+  const BallKind& k = kBallKinds.at(kind);
+  std::uint32_t i = n_;
+  resize(n_ + 1);
+  pos_[i] = {p.x, p.y, p.z, 0.5f * k.diameter};
+  vel_[i] = vel_half_[i] = {v.x, v.y, v.z, k.mass};
+  acc_[i] = {0.0f, -model_.gravity, 0.0f, 0.0f};
+  kind_[i] = static_cast<std::uint8_t>(kind);
+  id_[i] = next_id_++;
+  needs_rebuild_ = true;
+}
+
+std::uint32_t World::add_player() {
+  std::uint32_t id = next_player_id_++;
+  Vec3 centre = params_.tank.min + params_.tank.size() * 0.5f;
+  player_ids_.push_back(id);
+  player_pos_.push_back({centre.x, centre.y, centre.z, 0.5f * kPlayerDiameter});
+  player_vel_.push_back({});
+  return id;
+}
+
+bool World::remove_player(std::uint32_t id) {
+  auto it = std::find(player_ids_.begin(), player_ids_.end(), id);
+  if (it == player_ids_.end()) return false;
+  auto k = it - player_ids_.begin();
+  player_ids_.erase(it);
+  player_pos_.erase(player_pos_.begin() + k);
+  player_vel_.erase(player_vel_.begin() + k);
+  return true;
+}
+
+bool World::set_player_velocity(std::uint32_t id, Vec3 v) {
+  auto it = std::find(player_ids_.begin(), player_ids_.end(), id);
+  if (it == player_ids_.end() || !is_finite(v)) return false;
+  float speed = length(v);
+  if (speed > params_.player_max_speed) v = v * (params_.player_max_speed / speed);
+  player_vel_[it - player_ids_.begin()] = {v.x, v.y, v.z, 0.0f};
+  return true;
+}
+
+Vec3 World::player_position(std::uint32_t id) const {
+  auto it = std::find(player_ids_.begin(), player_ids_.end(), id);
+  if (it == player_ids_.end()) return {};
+  const Float4& p = player_pos_[it - player_ids_.begin()];
+  return {p.x, p.y, p.z};
+}
+
+void World::move_players() {
+  // Kinematic: the sphere goes where it is told, stopping at the walls.
+  const TankBounds& t = params_.tank;
+  for (std::size_t p = 0; p < player_pos_.size(); ++p) {
+    Float4& pos = player_pos_[p];
+    Float4& vel = player_vel_[p];
+    float* x[3] = {&pos.x, &pos.y, &pos.z};
+    float* v[3] = {&vel.x, &vel.y, &vel.z};
+    const float lo[3] = {t.min.x, t.min.y, t.min.z}, hi[3] = {t.max.x, t.max.y, t.max.z};
+    for (int a = 0; a < 3; ++a) {
+      *x[a] += *v[a] * model_.dt;
+      if (*x[a] < lo[a] + pos.w || *x[a] > hi[a] - pos.w) {
+        *x[a] = std::clamp(*x[a], lo[a] + pos.w, hi[a] - pos.w);
+        *v[a] = 0.0f;
+      }
+    }
+  }
+}
+
+void World::spawn() {
+  PhaseTimer timer(phase_seconds_.spawn);
+  placed_.clear();
+  spawner_.place(pos_.data(), n_, player_pos_.data(), static_cast<int>(player_pos_.size()), placed_);
+  if (placed_.empty()) return;
+  std::uint32_t first = n_;
+  resize(n_ + static_cast<std::uint32_t>(placed_.size()));
+  for (std::size_t b = 0; b < placed_.size(); ++b) {
+    std::uint32_t i = first + static_cast<std::uint32_t>(b);
+    pos_[i] = placed_[b].pos;
+    vel_[i] = vel_half_[i] = placed_[b].vel;
+    acc_[i] = {0.0f, -model_.gravity, 0.0f, 0.0f};
+    kind_[i] = static_cast<std::uint8_t>(placed_[b].kind);
+    id_[i] = next_id_++;
+  }
+  needs_rebuild_ = true;
+}
+
+void World::rebuild() {
+  PhaseTimer timer(phase_seconds_.neighbours);
+  list_.sort(pos_.data(), n_, order_);
+  {
+    AlignedVector<Float4> scratch;
+    for (auto* v : {&pos_, &vel_, &vel_half_, &acc_}) apply_order(*v, order_, scratch);
+    std::vector<std::uint8_t> kind_scratch;
+    apply_order(kind_, order_, kind_scratch);
+    std::vector<std::uint32_t> id_scratch;
+    apply_order(id_, order_, id_scratch);
+  }
+  std::copy(pos_.begin(), pos_.end(), pos_at_build_.begin());
+
+  if (list_.stride() == 0) list_.reserve(n_, 32);
+  for (;;) {
+    list_.reserve(n_, list_.stride());
+    std::fill(thread_longest_.begin(), thread_longest_.end(), 0u);
+    pool_.run(n_, [this](std::uint32_t begin, std::uint32_t end, int thread) {
+      thread_longest_[thread] = list_.build(pos_.data(), n_, begin, end);
+    });
+    std::uint32_t longest = *std::max_element(thread_longest_.begin(), thread_longest_.end());
+    if (longest <= list_.stride()) break;
+    list_.reserve(n_, longest + 8);
+  }
+  needs_rebuild_ = false;
+  ++rebuilds_;
+}
+
+StepArrays World::arrays() {
+  return StepArrays{pos_.data(),
+                    vel_.data(),
+                    vel_half_.data(),
+                    acc_.data(),
+                    pos_at_build_.data(),
+                    list_.neighbours(),
+                    list_.counts(),
+                    list_.stride(),
+                    player_pos_.data(),
+                    player_vel_.data(),
+                    static_cast<int>(player_pos_.size())};
+}
+
+void World::step() {
+  if (spawner_.pending() > 0 && steps_ % kSpawnInterval == 0) spawn();
+  if (needs_rebuild_) rebuild();
+
+  float max_d2 = 0.0f;
+  {
+    PhaseTimer timer(phase_seconds_.kick_drift);
+    std::fill(thread_max_d2_.begin(), thread_max_d2_.end(), 0.0f);
+    StepArrays s = arrays();
+    pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int thread) {
+      thread_max_d2_[thread] = kernels_.kick_drift(s, model_, begin, end);
+    });
+    for (float d2 : thread_max_d2_) max_d2 = std::max(max_d2, d2);
+    move_players();
+  }
+  const float half_skin = 0.5f * params_.skin;
+  if (!(max_d2 <= half_skin * half_skin)) rebuild();  // NaN also forces a rebuild
+
+  {
+    PhaseTimer timer(phase_seconds_.forces);
+    StepArrays s = arrays();
+    pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int) { kernels_.forces_kick(s, model_, begin, end); });
+  }
+  time_ += model_.dt;
+  ++steps_;
+}
+
+double World::mean_neighbours() const {
+  if (n_ == 0 || list_.stride() == 0) return 0.0;
+  double sum = 0.0;
+  for (std::uint32_t i = 0; i < n_; ++i) sum += list_.counts()[i];
+  return sum / n_;
+}
+
+BallView World::ball(std::uint32_t id) const {
+  for (std::uint32_t i = 0; i < n_; ++i)
+    if (id_[i] == id) return {pos_[i], vel_[i], kind_[i]};
+  return {Float4{}, Float4{}, -1};
+}
+
+double World::kinetic_energy() const {
+  double e = 0.0;
+  for (std::uint32_t i = 0; i < n_; ++i) {
+    const Float4& v = vel_[i];
+    e += 0.5 * v.w * (double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z);
+  }
+  return e;
+}
+
+double World::potential_energy() const {
+  double e = 0.0;
+  for (std::uint32_t i = 0; i < n_; ++i) e += double(vel_[i].w) * model_.gravity * pos_[i].y;
+  return e;
+}
+
+float World::max_overlap_fraction() const {
+  float worst = 0.0f;
+  const TankBounds& t = params_.tank;
+  for (std::uint32_t i = 0; i < n_; ++i) {
+    const Float4& p = pos_[i];
+    // Pairs are found by brute force over the neighbour list, which holds every touching pair.
+    if (!needs_rebuild_) {
+      const std::uint32_t* list = list_.neighbours() + std::size_t(i) * list_.stride();
+      for (std::uint32_t n = 0; n < list_.counts()[i]; ++n) {
+        const Float4& q = pos_[list[n]];
+        float dx = p.x - q.x, dy = p.y - q.y, dz = p.z - q.z;
+        float overlap = p.w + q.w - std::sqrt(dx * dx + dy * dy + dz * dz);
+        worst = std::max(worst, overlap / std::min(p.w, q.w));
+      }
+    }
+    float walls = std::max({t.min.x + p.w - p.x, p.x + p.w - t.max.x, t.min.y + p.w - p.y, p.y + p.w - t.max.y,
+                            t.min.z + p.w - p.z, p.z + p.w - t.max.z});
+    worst = std::max(worst, walls / p.w);
+  }
+  return worst;
+}
+
+float World::pile_top() const {
+  float top = params_.tank.min.y;
+  for (std::uint32_t i = 0; i < n_; ++i) top = std::max(top, pos_[i].y + pos_[i].w);
+  return top;
+}
+
+std::uint32_t World::escaped_or_invalid() const {
+  const TankBounds& t = params_.tank;
+  std::uint32_t bad = 0;
+  for (std::uint32_t i = 0; i < n_; ++i) {
+    const Float4& p = pos_[i];
+    const Float4& v = vel_[i];
+    bool inside = p.x >= t.min.x && p.x <= t.max.x && p.y >= t.min.y && p.y <= t.max.y && p.z >= t.min.z &&
+                  p.z <= t.max.z;  // false for NaN
+    bool finite = std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+    if (!inside || !finite) ++bad;
+  }
+  return bad;
+}
+
+std::uint64_t World::state_hash() const {
+  std::vector<std::uint32_t> by_id(n_);
+  for (std::uint32_t i = 0; i < n_; ++i) by_id[id_[i]] = i;
+  std::uint64_t h = 1469598103934665603ull;
+  auto mix = [&h](const void* data, std::size_t bytes) {
+    const auto* b = static_cast<const unsigned char*>(data);
+    for (std::size_t k = 0; k < bytes; ++k) h = (h ^ b[k]) * 1099511628211ull;
+  };
+  for (std::uint32_t i : by_id) {
+    mix(&pos_[i], sizeof(Float4));
+    mix(&vel_[i], sizeof(Float4));
+  }
+  return h;
+}
+
+}  // namespace fishtank

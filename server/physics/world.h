@@ -1,0 +1,146 @@
+#pragma once
+// The simulated world: ball state, the spawn queue, player spheres, and the
+// fixed-dt step. Only the thread that owns a World touches it.
+//
+// One step (server/physics/world.cpp, step()):
+//
+//   spawn round (every kSpawnInterval steps while balls are queued)
+//   kick_drift   ║ parallel over balls   v_half = v + a dt/2, x += v_half dt
+//   players move   (serial, few)
+//   rebuild?       if a ball moved > skin/2: sort by cell, reorder, new lists
+//   forces_kick  ║ parallel over balls   a = F/m + g, v = v_half + a dt/2
+//
+// Ball arrays are reordered by every rebuild; id() gives each ball's
+// permanent number (its order of appearance) for anyone who tracks balls.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/float4.h"
+#include "common/tank.h"
+#include "server/physics/broadphase.h"
+#include "server/physics/kernels.h"
+#include "server/physics/params.h"
+#include "server/physics/spawner.h"
+#include "server/physics/worker_pool.h"
+
+namespace fishtank {
+
+struct PhaseSeconds {
+  double spawn = 0.0;
+  double kick_drift = 0.0;
+  double neighbours = 0.0;
+  double forces = 0.0;
+};
+
+struct AddResult {
+  std::uint32_t accepted = 0;
+  std::string refusal;  // empty when everything asked for was accepted
+};
+
+struct BallView {
+  Float4 pos;  // x, y, z, radius
+  Float4 vel;  // vx, vy, vz, mass
+  int kind;
+};
+
+class World {
+ public:
+  // params must pass validate(). threads is ignored (1) for unthreaded kernels.
+  World(const PhysicsParams& params, const Kernels& kernels, int threads, std::uint64_t seed);
+
+  // Queues balls to pour in from the top, up to max_balls() including those queued.
+  AddResult add_balls(std::int64_t count);
+  // Puts one ball exactly there, without any overlap check (scenes and tests).
+  void place_ball(int kind, Vec3 pos, Vec3 vel);
+  void set_max_balls(std::uint32_t max_balls) { max_balls_ = max_balls; }
+
+  // Kinematic player spheres; ids are never reused.
+  std::uint32_t add_player();
+  bool remove_player(std::uint32_t id);
+  // Desired velocity, clamped to the maximum player speed. False if non-finite or unknown id.
+  bool set_player_velocity(std::uint32_t id, Vec3 velocity);
+  Vec3 player_position(std::uint32_t id) const;
+  std::size_t player_count() const { return player_ids_.size(); }
+  const std::vector<std::uint32_t>& player_ids() const { return player_ids_; }
+  const Float4* player_positions() const { return player_pos_.data(); }
+
+  void step();
+
+  std::uint32_t ball_count() const { return n_; }
+  std::uint32_t pending() const { return spawner_.pending(); }
+  std::uint32_t max_balls() const { return max_balls_; }
+  // Balls of the default mix that fill the tank to a packing fraction of 0.6.
+  std::uint32_t capacity() const { return capacity_; }
+  double time() const { return time_; }
+  std::uint64_t steps() const { return steps_; }
+  std::uint64_t rebuilds() const { return rebuilds_; }
+  float dt() const { return model_.dt; }
+  const PhysicsParams& params() const { return params_; }
+  const ContactModel& model() const { return model_; }
+  const Kernels& kernels() const { return kernels_; }
+  int threads() const { return pool_.threads(); }
+  const PhaseSeconds& phase_seconds() const { return phase_seconds_; }
+  double mean_neighbours() const;
+
+  // Current (sorted) order; index with i < ball_count().
+  const Float4* positions() const { return pos_.data(); }
+  const Float4* velocities() const { return vel_.data(); }
+  const std::uint8_t* kinds() const { return kind_.data(); }
+  const std::uint32_t* ids() const { return id_.data(); }
+  // The ball with permanent number id (linear search: for tests and tools).
+  BallView ball(std::uint32_t id) const;
+
+  double kinetic_energy() const;
+  double potential_energy() const;  // gravity, relative to y = 0
+  // Largest overlap (ball-ball, ball-wall), as a fraction of the smaller radius.
+  float max_overlap_fraction() const;
+  float pile_top() const;  // highest point of any ball
+  // Balls whose centre is outside the tank or whose state is not finite.
+  std::uint32_t escaped_or_invalid() const;
+  // FNV-1a over positions and velocities in id order: equal iff bit-identical.
+  std::uint64_t state_hash() const;
+
+  static constexpr int kSpawnInterval = 20;
+
+ private:
+  void spawn();
+  void rebuild();
+  void move_players();
+  void resize(std::uint32_t n);
+  void set_ghost();
+  StepArrays arrays();
+
+  PhysicsParams params_;
+  ContactModel model_;
+  const Kernels& kernels_;
+  WorkerPool pool_;
+  Spawner spawner_;
+  NeighbourList list_;
+
+  std::uint32_t n_ = 0;
+  // n_ balls, then one ghost far away that pads neighbour lists to a multiple of 4.
+  AlignedVector<Float4> pos_, vel_, vel_half_, acc_, pos_at_build_;
+  std::vector<std::uint8_t> kind_;
+  std::vector<std::uint32_t> id_;
+  std::uint32_t next_id_ = 0;
+  bool needs_rebuild_ = true;
+
+  std::vector<std::uint32_t> player_ids_;
+  AlignedVector<Float4> player_pos_, player_vel_;
+  std::uint32_t next_player_id_ = 0;
+
+  std::uint32_t capacity_;
+  std::uint32_t max_balls_;
+  std::vector<float> thread_max_d2_;
+  std::vector<std::uint32_t> thread_longest_;
+  std::vector<std::uint32_t> order_;
+  std::vector<NewBall> placed_;
+  double time_ = 0.0;
+  std::uint64_t steps_ = 0;
+  std::uint64_t rebuilds_ = 0;
+  PhaseSeconds phase_seconds_;
+};
+
+}  // namespace fishtank

@@ -1,0 +1,28 @@
+#pragma once
+// Steps a world paced to the wall clock: simulated time follows real time at
+// the fixed dt. Reports steps actually done per second and the load (the busy
+// fraction of the wall time), so headroom is visible.
+
+#include <atomic>
+#include <functional>
+
+#include "server/physics/world.h"
+
+namespace fishtank {
+
+struct LoopStatus {
+  double steps_per_s = 0.0;
+  double load = 0.0;            // 0..1: time spent stepping / wall time
+  std::uint64_t dropped_steps = 0;  // steps skipped because the machine fell behind
+};
+
+struct LoopOptions {
+  double duration = 0.0;  // seconds; 0 runs until stop is set
+  double status_interval = 1.0;
+  // Called on the loop's thread between steps, once per status interval.
+  std::function<void(const World&, const LoopStatus&)> on_status;
+};
+
+void run_realtime(World& world, const LoopOptions& options, const std::atomic<bool>& stop);
+
+}  // namespace fishtank
