@@ -1,0 +1,248 @@
+#include "protocol/frame_codec.h"
+
+#include <cmath>
+#include <cstring>
+
+namespace fishtank::protocol {
+
+namespace {
+
+// Message -> payload table -> vector is three levels and two tables; a little
+// room above that, and nothing like the defaults (64 levels, a million tables).
+constexpr flatbuffers::uoffset_t kMaxDepth = 8;
+constexpr flatbuffers::uoffset_t kMaxTables = 8;
+// The smallest FlatBuffers buffer: root offset and file identifier.
+constexpr std::uint32_t kMinBodyBytes = 8;
+
+wire::Vec3f to_wire(Vec3 v) { return {v.x, v.y, v.z}; }
+
+template <typename T>
+Frame finish(flatbuffers::FlatBufferBuilder& b, flatbuffers::Offset<T> payload) {
+  const auto message = wire::CreateMessage(b, wire::PayloadTraits<T>::enum_value, payload.Union());
+  b.FinishSizePrefixed(message, kFileIdentifier);
+  return Frame(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize());
+}
+
+bool finite(const wire::Vec3f* v) {
+  return v && std::isfinite(v->x()) && std::isfinite(v->y()) && std::isfinite(v->z());
+}
+
+DecodeResult failure(DecodeStatus status, std::string why) { return {status, nullptr, std::move(why)}; }
+
+bool accepted_by(wire::Payload type, Direction to) {
+  switch (type) {
+    case wire::Payload::Hello:
+    case wire::Payload::PlayerInput:
+    case wire::Payload::AddBalls:
+    case wire::Payload::Ping:
+      return to == Direction::to_server;
+    case wire::Payload::Welcome:
+    case wire::Payload::BallKinds:
+    case wire::Payload::Snapshot:
+    case wire::Payload::Error:
+    case wire::Payload::Pong:
+      return to == Direction::to_client;
+    default:
+      return false;
+  }
+}
+
+// Values the Verifier cannot judge. Empty when the message is usable.
+std::string check_values(const wire::Message& m) {
+  switch (m.payload_type()) {
+    case wire::Payload::Hello: {
+      const auto* name = m.payload_as_Hello()->client_name();
+      if (name && name->size() > kMaxClientNameBytes)
+        return "client_name is " + std::to_string(name->size()) + " bytes; at most " +
+               std::to_string(kMaxClientNameBytes) + " are allowed";
+      return {};
+    }
+    case wire::Payload::PlayerInput:
+      if (!finite(m.payload_as_PlayerInput()->velocity())) return "PlayerInput.velocity is missing or not finite";
+      return {};
+    case wire::Payload::AddBalls: {
+      const std::uint32_t count = m.payload_as_AddBalls()->count();
+      if (count < 1 || count > kMaxAddBallsPerRequest)
+        return "AddBalls.count must be between 1 and " + std::to_string(kMaxAddBallsPerRequest) + ", got " +
+               std::to_string(count);
+      return {};
+    }
+    case wire::Payload::Ping:
+    case wire::Payload::Pong:
+      return {};
+    case wire::Payload::Welcome: {
+      const wire::Welcome& w = *m.payload_as_Welcome();
+      if (!finite(w.tank_min()) || !finite(w.tank_max())) return "Welcome tank bounds are missing or not finite";
+      if (!(w.tank_min()->x() < w.tank_max()->x() && w.tank_min()->y() < w.tank_max()->y() &&
+            w.tank_min()->z() < w.tank_max()->z()))
+        return "Welcome tank_min is not below tank_max on every axis";
+      if (!std::isfinite(w.dt()) || w.dt() <= 0.0f) return "Welcome.dt is not a positive number";
+      if (!w.ball_kinds() || w.ball_kinds()->size() == 0 || w.ball_kinds()->size() > 256)
+        return "Welcome.ball_kinds must list 1 to 256 kinds";
+      for (const wire::BallKindInfo* k : *w.ball_kinds())
+        if (!std::isfinite(k->diameter()) || k->diameter() <= 0.0f || !std::isfinite(k->mass()) || k->mass() <= 0.0f)
+          return "Welcome.ball_kinds has a non-positive or non-finite diameter or mass";
+      return {};
+    }
+    case wire::Payload::BallKinds: {
+      const wire::BallKinds& k = *m.payload_as_BallKinds();
+      if (!k.kinds()) return "BallKinds.kinds is missing";
+      if (std::uint64_t{k.first_new_ball()} + k.kinds()->size() > UINT32_MAX) return "BallKinds ball ids overflow";
+      return {};
+    }
+    case wire::Payload::Snapshot: {
+      const wire::Snapshot& s = *m.payload_as_Snapshot();
+      const std::uint64_t values = s.positions() ? s.positions()->size() : 0;
+      if (values != 3 * std::uint64_t{s.ball_count()})
+        return "Snapshot has " + std::to_string(values) + " position values for " + std::to_string(s.ball_count()) +
+               " balls (3 per ball expected)";
+      const std::size_t ids = s.player_ids() ? s.player_ids()->size() : 0;
+      const std::size_t positions = s.player_positions() ? s.player_positions()->size() : 0;
+      if (ids != positions) return "Snapshot player_ids and player_positions differ in length";
+      if (s.player_positions())
+        for (const wire::Vec3f* p : *s.player_positions())
+          if (!finite(p)) return "Snapshot has a non-finite player position";
+      if (!std::isfinite(s.sim_time()) || !std::isfinite(s.steps_per_s()) || !std::isfinite(s.load()))
+        return "Snapshot has a non-finite time, rate or load";
+      return {};
+    }
+    case wire::Payload::Error:
+      if (!m.payload_as_Error()->message()) return "Error.message is missing";
+      return {};
+    default:
+      return "unknown payload type";
+  }
+}
+
+}  // namespace
+
+Frame encode_hello(std::string_view client_name, bool wants_player, std::uint32_t version) {
+  flatbuffers::FlatBufferBuilder b(128);
+  const auto name = b.CreateString(client_name.data(), client_name.size());
+  return finish(b, wire::CreateHello(b, version, name, wants_player));
+}
+
+Frame encode_player_input(std::uint32_t sequence, Vec3 velocity) {
+  flatbuffers::FlatBufferBuilder b(64);
+  const wire::Vec3f v = to_wire(velocity);
+  return finish(b, wire::CreatePlayerInput(b, sequence, &v));
+}
+
+Frame encode_add_balls(std::uint32_t count) {
+  flatbuffers::FlatBufferBuilder b(64);
+  return finish(b, wire::CreateAddBalls(b, count));
+}
+
+Frame encode_ping(std::uint32_t client_time_us) {
+  flatbuffers::FlatBufferBuilder b(64);
+  return finish(b, wire::CreatePing(b, client_time_us));
+}
+
+Frame encode_welcome(const WelcomeInfo& info) {
+  flatbuffers::FlatBufferBuilder b(512);
+  const auto variant = b.CreateString(info.server_variant);
+  const auto simd = b.CreateString(info.simd_level);
+  std::vector<wire::BallKindInfo> kinds;
+  for (const BallKind& k : kBallKinds) kinds.emplace_back(k.diameter, k.mass, k.rgb[0], k.rgb[1], k.rgb[2]);
+  const auto kinds_offset = b.CreateVectorOfStructs(kinds);
+  const wire::Vec3f tank_min = to_wire(info.tank.min), tank_max = to_wire(info.tank.max);
+  return finish(b, wire::CreateWelcome(b, kProtocolVersion, info.client_id, variant, simd, info.worker_threads,
+                                       &tank_min, &tank_max, info.dt, kinds_offset, info.player_id.has_value(),
+                                       info.player_id.value_or(0), info.snapshot_rate_hz));
+}
+
+Frame encode_ball_kinds(std::uint32_t first_new_ball, const std::uint8_t* kinds, std::size_t count) {
+  flatbuffers::FlatBufferBuilder b(64 + count);
+  const auto kinds_offset = b.CreateVector(kinds, count);
+  return finish(b, wire::CreateBallKinds(b, first_new_ball, kinds_offset));
+}
+
+Frame encode_snapshot(const SnapshotHeader& header, const std::uint16_t* quantised, std::uint32_t ball_count,
+                      const std::uint32_t* player_ids, const Vec3* player_positions, std::size_t players) {
+  const std::size_t values = 3 * std::size_t{ball_count};
+  flatbuffers::FlatBufferBuilder b(256 + 2 * values + 16 * players);
+  const auto positions = b.CreateVector(quantised, values);
+  const auto ids = b.CreateVector(player_ids, players);
+  wire::Vec3f* player_out = nullptr;
+  const auto player_offset = b.CreateUninitializedVectorOfStructs(players, &player_out);
+  for (std::size_t i = 0; i < players; ++i) player_out[i] = to_wire(player_positions[i]);
+  return finish(b, wire::CreateSnapshot(b, header.tick, header.sim_time, header.physics_steps, header.steps_per_s,
+                                        header.load, ball_count, positions, ids, player_offset));
+}
+
+Frame encode_error(wire::ErrorCode code, std::string_view message) {
+  flatbuffers::FlatBufferBuilder b(128 + message.size());
+  const auto text = b.CreateString(message.data(), message.size());
+  return finish(b, wire::CreateError(b, code, text));
+}
+
+Frame encode_pong(std::uint32_t client_time_us) {
+  flatbuffers::FlatBufferBuilder b(64);
+  return finish(b, wire::CreatePong(b, client_time_us));
+}
+
+std::uint32_t max_frame_bytes(Direction to) {
+  return to == Direction::to_server ? kMaxClientFrameBytes : kMaxServerFrameBytes;
+}
+
+DecodeResult check_length_prefix(const std::uint8_t prefix[kLengthPrefixBytes], Direction to,
+                                 std::uint32_t* body_bytes) {
+  const std::uint32_t length = std::uint32_t{prefix[0]} | std::uint32_t{prefix[1]} << 8 |
+                               std::uint32_t{prefix[2]} << 16 | std::uint32_t{prefix[3]} << 24;
+  if (length < kMinBodyBytes || length > max_frame_bytes(to))
+    return failure(DecodeStatus::bad_length, "frame length " + std::to_string(length) + " is outside " +
+                                                 std::to_string(kMinBodyBytes) + " .. " +
+                                                 std::to_string(max_frame_bytes(to)) + " bytes");
+  *body_bytes = length;
+  return {};
+}
+
+DecodeResult decode_frame(const std::uint8_t* frame, std::size_t size, Direction to) {
+  std::uint32_t body_bytes = 0;
+  if (size < kLengthPrefixBytes) return failure(DecodeStatus::bad_length, "frame shorter than its length prefix");
+  if (DecodeResult r = check_length_prefix(frame, to, &body_bytes); !r.ok()) return r;
+  if (size != kLengthPrefixBytes + body_bytes)
+    return failure(DecodeStatus::bad_length, "length prefix does not match the frame size");
+  if (!flatbuffers::BufferHasIdentifier(frame, kFileIdentifier, /*size_prefixed=*/true))
+    return failure(DecodeStatus::malformed, "not a Fishtank frame (file identifier is not FTNK)");
+  flatbuffers::Verifier verifier(frame, size, kMaxDepth, kMaxTables);
+  if (!wire::VerifySizePrefixedMessageBuffer(verifier))
+    return failure(DecodeStatus::malformed, "frame failed FlatBuffers verification");
+  const wire::Message* message = wire::GetSizePrefixedMessage(frame);
+  if (message->payload_type() == wire::Payload::NONE) return failure(DecodeStatus::invalid_value, "empty message");
+  if (!accepted_by(message->payload_type(), to))
+    return failure(DecodeStatus::wrong_direction,
+                   std::string("message type ") +
+                       (message->payload_type() <= wire::Payload::MAX ? wire::EnumNamePayload(message->payload_type())
+                                                                      : "unknown") +
+                       (to == Direction::to_server ? " is not accepted by the server" : " is not sent by servers"));
+  if (std::string why = check_values(*message); !why.empty()) return failure(DecodeStatus::invalid_value, why);
+  return {DecodeStatus::ok, message, {}};
+}
+
+void FrameReader::append(const std::uint8_t* data, std::size_t size) {
+  if (!broken_) pending_.insert(pending_.end(), data, data + size);
+}
+
+std::optional<DecodeResult> FrameReader::next() {
+  if (broken_) return broken_;
+  if (pending_.size() < kLengthPrefixBytes) return std::nullopt;
+  std::uint32_t body_bytes = 0;
+  if (DecodeResult r = check_length_prefix(pending_.data(), to_, &body_bytes); !r.ok()) {
+    pending_.clear();
+    broken_ = r;
+    return broken_;
+  }
+  const std::size_t frame_bytes = kLengthPrefixBytes + body_bytes;
+  if (pending_.size() < frame_bytes) return std::nullopt;
+  frame_.assign(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(frame_bytes));
+  pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(frame_bytes));
+  DecodeResult r = decode_frame(frame_.data(), frame_.size(), to_);
+  if (r.stream_broken()) {
+    pending_.clear();
+    broken_ = r;
+  }
+  return r;
+}
+
+}  // namespace fishtank::protocol
