@@ -31,9 +31,13 @@ struct CacheAlignedAllocator {
   }
   void deallocate(T* p, std::size_t) { std::free(p); }
   template <class U>
-  bool operator==(const CacheAlignedAllocator<U>&) const { return true; }
+  bool operator==(const CacheAlignedAllocator<U>&) const {
+    return true;
+  }
   template <class U>
-  bool operator!=(const CacheAlignedAllocator<U>&) const { return false; }
+  bool operator!=(const CacheAlignedAllocator<U>&) const {
+    return false;
+  }
 };
 
 template <class T>

@@ -3,9 +3,8 @@
 // describe the run as one JSON object.
 
 #include <cstdint>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "server/bench/scenes.h"
 #include "server/physics/world.h"

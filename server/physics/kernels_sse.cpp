@@ -45,8 +45,7 @@ inline F4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t 
   for (std::uint32_t n = 0; n < count; n += 4) {
     const std::uint32_t j0 = list[n], j1 = list[n + 1], j2 = list[n + 2], j3 = list[n + 3];
     F4 xj, yj, zj, rj;
-    simd::transpose(F4::load(s.pos[j0]), F4::load(s.pos[j1]), F4::load(s.pos[j2]), F4::load(s.pos[j3]), xj, yj,
-                    zj, rj);
+    simd::transpose(F4::load(s.pos[j0]), F4::load(s.pos[j1]), F4::load(s.pos[j2]), F4::load(s.pos[j3]), xj, yj, zj, rj);
     F4 dx = xi - xj, dy = yi - yj, dz = zi - zj;
     F4 d2 = dx * dx + dy * dy + dz * dz;
     F4 reach = ri + rj;

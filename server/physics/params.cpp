@@ -21,9 +21,7 @@ float smallest_effective_mass() {
   return lightest * lightest / (lightest + lightest);
 }
 
-float contact_duration(float stiffness) {
-  return kPi * std::sqrt(smallest_effective_mass() / stiffness);
-}
+float contact_duration(float stiffness) { return kPi * std::sqrt(smallest_effective_mass() / stiffness); }
 
 float derived_dt(const PhysicsParams& p) {
   return p.dt > 0.0f ? p.dt : contact_duration(p.stiffness) / static_cast<float>(p.steps_per_contact);
@@ -36,13 +34,14 @@ std::string validate(const PhysicsParams& p) {
   else if (!std::isfinite(p.restitution) || p.restitution <= 0.0f || p.restitution > 1.0f)
     err << "restitution e must be in (0, 1], got " << p.restitution;
   else if (p.steps_per_contact < PhysicsParams::kMinStepsPerContact || p.steps_per_contact > 100000)
-    err << "steps per contact must be in [" << PhysicsParams::kMinStepsPerContact
-        << ", 100000], got " << p.steps_per_contact;
+    err << "steps per contact must be in [" << PhysicsParams::kMinStepsPerContact << ", 100000], got "
+        << p.steps_per_contact;
   else if (!std::isfinite(p.dt) || p.dt < 0.0f)
     err << "dt must be a positive number of seconds (or 0 for automatic), got " << p.dt;
   else if (p.dt > contact_duration(p.stiffness) / PhysicsParams::kMinStepsPerContact)
-    err << "dt = " << p.dt << " s is unstable for k = " << p.stiffness << " N/m: a contact lasts t_c = "
-        << contact_duration(p.stiffness) << " s and needs at least " << PhysicsParams::kMinStepsPerContact
+    err << "dt = " << p.dt << " s is unstable for k = " << p.stiffness
+        << " N/m: a contact lasts t_c = " << contact_duration(p.stiffness) << " s and needs at least "
+        << PhysicsParams::kMinStepsPerContact
         << " steps, so dt must be <= " << contact_duration(p.stiffness) / PhysicsParams::kMinStepsPerContact
         << " s (automatic: " << contact_duration(p.stiffness) / p.steps_per_contact << " s)";
   else if (!std::isfinite(p.skin) || p.skin <= 0.0f || p.skin > 10.0f)

@@ -14,12 +14,12 @@
 namespace fishtank {
 
 struct PhysicsParams {
-  float stiffness = 2.0e4f;      // k, N/m: keeps a full tank's overlap a few % of r_min
-  float restitution = 0.6f;      // e, measured rebound / approach normal speed
-  int steps_per_contact = 20;    // n in dt = t_c / n
-  float dt = 0.0f;               // 0: derive from k; otherwise must be <= t_c / kMinStepsPerContact
-  float skin = 0.3f;             // neighbour-list skin, units
-  float gravity = 9.81f;         // m/s^2, along -y
+  float stiffness = 2.0e4f;        // k, N/m: keeps a full tank's overlap a few % of r_min
+  float restitution = 0.6f;        // e, measured rebound / approach normal speed
+  int steps_per_contact = 20;      // n in dt = t_c / n
+  float dt = 0.0f;                 // 0: derive from k; otherwise must be <= t_c / kMinStepsPerContact
+  float skin = 0.3f;               // neighbour-list skin, units
+  float gravity = 9.81f;           // m/s^2, along -y
   float player_max_speed = 10.0f;  // m/s; faster commands are clamped
   TankBounds tank;
 

@@ -40,7 +40,8 @@ void Spawner::place(const Float4* pos, std::uint32_t n, const Float4* players, i
 
   for (auto& balls : near_top_) balls.clear();
   for (std::uint32_t i = 0; i < n; ++i) {
-    if (pos[i].y + pos[i].w > entry_floor || !std::isfinite(pos[i].y)) near_top_[slot_of(pos[i].x, pos[i].z)].push_back(i);
+    if (pos[i].y + pos[i].w > entry_floor || !std::isfinite(pos[i].y))
+      near_top_[slot_of(pos[i].x, pos[i].z)].push_back(i);
   }
 
   auto overlaps = [](const Float4& a, const Float4& b) {

@@ -32,8 +32,7 @@ class Spawner {
   std::uint32_t pending() const { return static_cast<std::uint32_t>(queue_.size()); }
 
   // Moves as many queued balls as fit into `placed`.
-  void place(const Float4* pos, std::uint32_t n, const Float4* players, int player_count,
-             std::vector<NewBall>& placed);
+  void place(const Float4* pos, std::uint32_t n, const Float4* players, int player_count, std::vector<NewBall>& placed);
 
   static constexpr float kEntrySpeed = 3.0f;  // m/s downward, so a layer clears quickly
 

@@ -1,8 +1,8 @@
 #include "server/physics/worker_pool.h"
 
-#include <algorithm>
-
 #include <immintrin.h>
+
+#include <algorithm>
 
 #include "common/fp_env.h"
 
@@ -13,9 +13,7 @@ namespace {
 constexpr int kSpinIterations = 20000;
 }  // namespace
 
-int WorkerPool::hardware_threads() {
-  return std::max(1u, boost::thread::hardware_concurrency());
-}
+int WorkerPool::hardware_threads() { return std::max(1u, boost::thread::hardware_concurrency()); }
 
 WorkerPool::WorkerPool(int threads) : thread_count_(std::max(1, threads)) {
   for (int t = 1; t < thread_count_; ++t) workers_.emplace_back([this, t] { worker_loop(t); });

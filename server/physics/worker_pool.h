@@ -13,13 +13,12 @@
 // plain call with no synchronisation at all.
 
 #include <atomic>
-#include <cstdint>
-#include <functional>
-#include <vector>
-
 #include <boost/thread/condition_variable.hpp>
 #include <boost/thread/mutex.hpp>
 #include <boost/thread/thread.hpp>
+#include <cstdint>
+#include <functional>
+#include <vector>
 
 namespace fishtank {
 

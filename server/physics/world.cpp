@@ -91,6 +91,7 @@ void World::place_ball(int kind, Vec3 p, Vec3 v) {
   kind_[i] = static_cast<std::uint8_t>(kind);
   id_[i] = next_id_++;
   needs_rebuild_ = true;
+  needs_initial_forces_ = true;
 }
 
 std::uint32_t World::add_player() {
@@ -207,9 +208,21 @@ StepArrays World::arrays() {
                     static_cast<int>(player_pos_.size())};
 }
 
+void World::compute_initial_forces() {
+  // The first half kick needs a(t0). forces_kick also finishes a kick
+  // (v = v_half + a dt/2), so it runs on a copy of v and v is put back after.
+  PhaseTimer timer(phase_seconds_.forces);
+  std::copy(vel_.begin(), vel_.end(), vel_half_.begin());
+  StepArrays s = arrays();
+  pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int) { kernels_.forces_kick(s, model_, begin, end); });
+  std::copy(vel_half_.begin(), vel_half_.end(), vel_.begin());
+  needs_initial_forces_ = false;
+}
+
 void World::step() {
   if (spawner_.pending() > 0 && steps_ % kSpawnInterval == 0) spawn();
   if (needs_rebuild_) rebuild();
+  if (needs_initial_forces_) compute_initial_forces();
 
   float max_d2 = 0.0f;
   {

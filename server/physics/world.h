@@ -53,6 +53,8 @@ class World {
   // Queues balls to pour in from the top, up to max_balls() including those queued.
   AddResult add_balls(std::int64_t count);
   // Puts one ball exactly there, without any overlap check (scenes and tests).
+  // Spawned balls touch nothing, so their first acceleration is gravity alone;
+  // placed ones may touch, so the next step starts with a force pass.
   void place_ball(int kind, Vec3 pos, Vec3 vel);
   void set_max_balls(std::uint32_t max_balls) { max_balls_ = max_balls; }
 
@@ -107,6 +109,8 @@ class World {
  private:
   void spawn();
   void rebuild();
+  // Placed balls may start in contact: their first half kick needs the real force.
+  void compute_initial_forces();
   void move_players();
   void resize(std::uint32_t n);
   void set_ghost();
@@ -126,6 +130,7 @@ class World {
   std::vector<std::uint32_t> id_;
   std::uint32_t next_id_ = 0;
   bool needs_rebuild_ = true;
+  bool needs_initial_forces_ = false;
 
   std::vector<std::uint32_t> player_ids_;
   AlignedVector<Float4> player_pos_, player_vel_;

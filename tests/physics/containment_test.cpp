@@ -1,0 +1,41 @@
+// A full tank, with the player sphere sweeping fast through the pile for 20
+// simulated seconds: no ball leaves the tank, none is lost, every value stays
+// finite, and the player stays inside.
+
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "tests/physics/scenarios.h"
+
+using namespace fishtank;
+using namespace fishtank::test;
+
+TEST_CASE("a full tank stays contained while the player ploughs through it", "[physics][containment][slow]") {
+  PhysicsParams params;
+  World world(params, kSseKernels, 2, 11);
+  pour_and_settle(world, 6000, 60.0);
+  REQUIRE(world.ball_count() == 6000);
+  REQUIRE(world.pending() == 0);
+  CHECK(world.escaped_or_invalid() == 0);
+  CHECK(world.max_overlap_fraction() < 0.10f);  // the default k keeps overlaps under 10% of r_min
+
+  const std::uint32_t player = world.add_player();
+  const float speed = params.player_max_speed;
+  // Sweep: a different axis direction every half second, through the pile and into the walls.
+  const Vec3 directions[] = {{1, 0, 0}, {0, -1, 0}, {-1, 0, 0}, {0, 0, 1}, {0, 1, 0}, {0, 0, -1}, {1, -1, 1}};
+  const int steps = static_cast<int>(20.0 / world.dt());
+  const int turn_every = static_cast<int>(0.5 / world.dt());
+  for (int s = 0; s < steps; ++s) {
+    if (s % turn_every == 0) world.set_player_velocity(player, directions[(s / turn_every) % 7] * speed);
+    world.step();
+    if (s % 500 == 0) REQUIRE(world.escaped_or_invalid() == 0);
+  }
+  CHECK(world.escaped_or_invalid() == 0);
+  CHECK(world.ball_count() == 6000);
+  const Vec3 p = world.player_position(player);
+  CHECK(p.x >= params.tank.min.x);
+  CHECK(p.x <= params.tank.max.x);
+  CHECK(p.y >= params.tank.min.y);
+  CHECK(p.y <= params.tank.max.y);
+  CHECK(std::isfinite(world.kinetic_energy()));
+}

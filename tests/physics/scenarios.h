@@ -1,0 +1,46 @@
+#pragma once
+// Small scenes shared by the physics tests.
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+#include "server/physics/world.h"
+
+namespace fishtank::test {
+
+// Both kernel twins, for tests that must hold for each.
+inline const Kernels& kernels_named(const std::string& name) { return name == "sse" ? kSseKernels : kScalarKernels; }
+
+// No gravity, in a tank wide enough that nothing reaches a wall by accident.
+inline PhysicsParams open_space() {
+  PhysicsParams p;
+  p.gravity = 0.0f;
+  p.tank.min = {-50.0f, 0.0f, -50.0f};
+  p.tank.max = {50.0f, 100.0f, 50.0f};
+  return p;
+}
+
+// Steps until the balls have met and parted again, at most max_steps.
+template <class Apart>
+inline void step_through_contact(World& world, Apart apart, int max_steps = 20000) {
+  bool touched = false;
+  for (int s = 0; s < max_steps; ++s) {
+    world.step();
+    if (!apart()) touched = true;
+    if (touched && apart()) return;
+  }
+}
+
+// Every ball of a poured tank, stepped until the queue is empty and the pile is at rest.
+inline void pour_and_settle(World& world, std::uint32_t balls, double max_seconds) {
+  world.add_balls(balls);
+  const int check_every = static_cast<int>(0.1 / world.dt());
+  for (double t = 0.0; t < max_seconds; t += world.dt()) {
+    world.step();
+    if (world.steps() % check_every == 0 && world.pending() == 0 && world.kinetic_energy() / world.ball_count() < 1e-3)
+      return;
+  }
+}
+
+}  // namespace fishtank::test

@@ -1,0 +1,56 @@
+// Stiff and extreme scenes stay finite and contained (SPEC 7.2, first part).
+
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "tests/physics/scenarios.h"
+
+using namespace fishtank;
+using namespace fishtank::test;
+
+TEST_CASE("contacts 100x stiffer than default stay finite and contained", "[physics][stability]") {
+  PhysicsParams params;
+  params.stiffness *= 100.0f;  // dt shrinks 10x with it
+  World world(params, kSseKernels, 2, 3);
+  pour_and_settle(world, 600, 12.0);
+  CHECK(world.ball_count() == 600);
+  CHECK(world.escaped_or_invalid() == 0);
+  CHECK(world.max_overlap_fraction() < 0.01f);  // stiffer springs, smaller overlaps
+}
+
+TEST_CASE("a tank packed beyond capacity pushes itself apart without losing a ball", "[physics][stability]") {
+  PhysicsParams params;
+  World world(params, kSseKernels, 2, 3);
+  // 8000 balls (capacity ~6100) on a lattice so tight that neighbours overlap
+  // by up to a third of a diameter: the springs store a lot of energy.
+  const int side = 20;  // 20 x 20 x 20 sites, 2 units apart
+  for (int b = 0; b < side * side * side; ++b) {
+    Vec3 p{-19.0f + 2.0f * (b % side), 1.0f + 2.0f * (b / (side * side)), -19.0f + 2.0f * ((b / side) % side)};
+    world.place_ball(b % kKindCount, p, {0.0f, 0.0f, 0.0f});
+  }
+  double peak_energy = 0.0;
+  for (int s = 0; s < static_cast<int>(3.0 / world.dt()); ++s) {
+    world.step();
+    if (s % 200 == 0) {
+      REQUIRE(world.escaped_or_invalid() == 0);
+      peak_energy = std::max(peak_energy, world.kinetic_energy());
+    }
+  }
+  CHECK(world.escaped_or_invalid() == 0);
+  CHECK(world.ball_count() == 8000);
+  // Damping drains the stored energy: the pile ends far calmer than its peak.
+  CHECK(world.kinetic_energy() < 0.1 * peak_energy);
+}
+
+TEST_CASE("restitution near 0 and at 1 stays finite and contained", "[physics][stability]") {
+  const float e = GENERATE(0.05f, 1.0f);
+  PhysicsParams params;
+  params.restitution = e;
+  World world(params, kSseKernels, 2, 4);
+  world.add_balls(800);
+  for (int s = 0; s < static_cast<int>(8.0 / world.dt()); ++s) world.step();
+  INFO("e = " << e);
+  CHECK(world.ball_count() + world.pending() == 800);
+  CHECK(world.escaped_or_invalid() == 0);
+  CHECK(std::isfinite(world.kinetic_energy()));
+}
