@@ -5,6 +5,9 @@
 // a 4x4 transpose, and the contact arithmetic runs on four pairs per
 // instruction. Velocities are loaded and transposed only when at least one of
 // the four touches, which in a settled pile skips about half of the blocks.
+// 1/|d| and sqrt(m_eff) come from the reciprocal-square-root estimate plus a
+// Newton step (1e-7 relative) instead of sqrt and divide; the scalar twin
+// computes them exactly, so the twins agree to float rounding, not bit for bit.
 
 #include "common/simd/sse_float4.h"
 #include "server/physics/kernels.h"
@@ -37,7 +40,7 @@ inline F4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t 
   const F4 vxi = simd::broadcast<0>(vi), vyi = simd::broadcast<1>(vi), vzi = simd::broadcast<2>(vi);
   const F4 mi = simd::broadcast<3>(vi);
   const F4 k = F4::splat(m.k), damping = F4::splat(m.damping_factor);
-  const F4 one = F4::splat(1.0f), tiny = F4::splat(1e-6f);
+  const F4 tiny = F4::splat(1e-12f);  // squared distance floor: coincident centres stay finite
 
   F4 fx = F4::zero(), fy = F4::zero(), fz = F4::zero();
   const std::uint32_t* list = s.neighbours + std::size_t(i) * s.stride;
@@ -55,11 +58,12 @@ inline F4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t 
     F4 vxj, vyj, vzj, mj;
     simd::transpose(F4::load(s.vel_half[j0]), F4::load(s.vel_half[j1]), F4::load(s.vel_half[j2]),
                     F4::load(s.vel_half[j3]), vxj, vyj, vzj, mj);
-    F4 dist = max(sqrt(d2), tiny);
-    F4 inv_dist = one / dist;
+    F4 inv_dist = simd::rsqrt(max(d2, tiny));
+    F4 dist = d2 * inv_dist;
     F4 nx = dx * inv_dist, ny = dy * inv_dist, nz = dz * inv_dist;
     F4 v_n = (vxi - vxj) * nx + (vyi - vyj) * ny + (vzi - vzj) * nz;
-    F4 c = damping * sqrt(mi * mj / (mi + mj));
+    F4 m_eff = mi * mj * simd::reciprocal(mi + mj);
+    F4 c = damping * m_eff * simd::rsqrt(m_eff);  // damping * sqrt(m_eff)
     F4 f = keep(touching, k * (reach - dist) - c * v_n);
     fx += f * nx;
     fy += f * ny;
