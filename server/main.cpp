@@ -1,14 +1,18 @@
 // fishtank-server: flags and wiring only. The variant (scalar or SSE) is fixed
 // at compile time by FISHTANK_SIMD; both executables come from this file.
 
-#include <csignal>
+#include <atomic>
 #include <cstdio>
 #include <iostream>
+
+#include <spdlog/sinks/stdout_sinks.h>
+#include <spdlog/spdlog.h>
 
 #include "common/fp_env.h"
 #include "server/bench/benchmark.h"
 #include "server/bench/scenes.h"
 #include "server/export/csv_dump.h"
+#include "server/net/network_service.h"
 #include "server/options.h"
 #include "server/realtime_loop.h"
 
@@ -24,9 +28,8 @@ const fishtank::Kernels& kKernels = fishtank::kSseKernels;
 const fishtank::Kernels& kKernels = fishtank::kScalarKernels;
 #endif
 
+// Set by SIGINT/SIGTERM (the network service's signal_set) to end the realtime loop.
 std::atomic<bool> g_stop{false};
-
-void request_stop(int) { g_stop = true; }
 
 int write_dump_if_asked(const fishtank::World& world, const fishtank::ServerOptions& o) {
   if (o.dump_path.empty()) return 0;
@@ -53,7 +56,28 @@ int run_bench(const fishtank::ServerOptions& o) {
   return write_dump_if_asked(world, o);
 }
 
+fishtank::net::NetOptions net_options(const fishtank::ServerOptions& o) {
+  fishtank::net::NetOptions net;
+  net.bind = o.bind;
+  net.port = o.port;
+  net.link.snapshot_rate_hz = o.snapshot_rate;
+  net.link.max_players = o.max_players;
+  return net;
+}
+
+fishtank::net::ServerInfo server_info(const fishtank::World& world, const fishtank::ServerOptions& o) {
+  fishtank::net::ServerInfo info;
+  info.variant = kKernels.variant;
+  info.simd = kKernels.simd;
+  info.worker_threads = static_cast<std::uint32_t>(world.threads());
+  info.tank = world.params().tank;
+  info.dt = world.dt();
+  info.snapshot_rate_hz = static_cast<float>(o.snapshot_rate);
+  return info;
+}
+
 int run_server(const fishtank::ServerOptions& o) {
+  spdlog::set_default_logger(spdlog::stderr_logger_mt("fishtank-server"));
   fishtank::World world(o.physics, kKernels, o.threads, o.bench_spec.scene.seed);
   if (o.max_balls > 0) world.set_max_balls(o.max_balls);
   if (o.start_balls > 0) {
@@ -63,14 +87,20 @@ int run_server(const fishtank::ServerOptions& o) {
   std::fprintf(stderr, "fishtank-server (%s, %s, %d threads): dt = %.3g s, k = %g N/m, e = %g; Ctrl-C stops\n",
                kKernels.variant, kKernels.simd, world.threads(), world.dt(), o.physics.stiffness,
                o.physics.restitution);
-  std::signal(SIGINT, request_stop);
-  std::signal(SIGTERM, request_stop);
+  fishtank::net::NetworkService network(net_options(o), server_info(world, o), g_stop);
+  if (std::string error = network.start(); !error.empty()) {
+    std::cerr << "fishtank-server: " << error << "\n";
+    return 1;
+  }
   fishtank::LoopOptions loop;
   loop.duration = o.duration;
   loop.status_interval = o.status_interval;
-  loop.on_status = [](const fishtank::World& w, const fishtank::LoopStatus& s) {
-    std::fprintf(stderr, "t = %7.1f s  balls %5u (+%u queued)  %6.0f steps/s  load %5.1f %%%s\n", w.time(),
-                 w.ball_count(), w.pending(), s.steps_per_s, 100.0 * s.load,
+  loop.at_step_boundary = [&network](fishtank::World& w, const fishtank::LoopStatus& s) {
+    network.at_step_boundary(w, s);
+  };
+  loop.on_status = [&network](const fishtank::World& w, const fishtank::LoopStatus& s) {
+    std::fprintf(stderr, "t = %7.1f s  balls %5u (+%u queued)  %6.0f steps/s  load %5.1f %%  %s%s\n", w.time(),
+                 w.ball_count(), w.pending(), s.steps_per_s, 100.0 * s.load, network.status().c_str(),
                  s.dropped_steps ? "  (falling behind real time)" : "");
   };
   fishtank::run_realtime(world, loop, g_stop);

@@ -32,6 +32,15 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "status-interval", po::value(&o.status_interval)->default_value(1.0), "seconds between status lines")(
       "dump", po::value(&o.dump_path), "write the final state as CSV (x,y,z,vx,vy,vz,diameter,mass)");
 
+  std::int64_t port = o.port, max_players = o.max_players;
+  po::options_description network("Network");
+  network.add_options()("bind", po::value(&o.bind)->default_value(o.bind),
+                        "address to listen on (127.0.0.1: this machine only; 0.0.0.0: every interface)")(
+      "port", po::value(&port)->default_value(port), "TCP port (0: pick a free one and print it)")(
+      "snapshot-rate", po::value(&o.snapshot_rate)->default_value(o.snapshot_rate), "snapshots per second sent to clients")(
+      "max-players", po::value(&max_players)->default_value(max_players),
+      "player spheres at most; later clients observe");
+
   po::options_description physics("Physics");
   physics.add_options()("stiffness", po::value(&o.physics.stiffness)->default_value(defaults.stiffness),
                         "contact spring constant k, N/m")(
@@ -50,7 +59,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "most simulated seconds to wait for rest (0: 90 for tank, 4 for wide)");
 
   po::options_description all;
-  all.add(general).add(physics).add(bench);
+  all.add(general).add(network).add(physics).add(bench);
 
   ParseResult result;
   std::ostringstream help;
@@ -94,6 +103,14 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   if (steps_per_contact < 1 || steps_per_contact > 100000)
     return fail("--steps-per-contact must be between 10 and 100000, got " + std::to_string(steps_per_contact));
 
+  if (port < 0 || port > 65535) return fail("--port must be between 0 and 65535, got " + std::to_string(port));
+  if (!std::isfinite(o.snapshot_rate) || o.snapshot_rate < 1.0 || o.snapshot_rate > 1000.0)
+    return fail("--snapshot-rate must be between 1 and 1000 per second");
+  if (max_players < 0 || max_players > 1000)
+    return fail("--max-players must be between 0 and 1000, got " + std::to_string(max_players));
+
+  o.port = static_cast<std::uint16_t>(port);
+  o.max_players = static_cast<std::uint32_t>(max_players);
   o.physics.steps_per_contact = static_cast<int>(steps_per_contact);
   o.threads = static_cast<int>(threads);
   o.start_balls = static_cast<std::uint32_t>(balls);

@@ -20,6 +20,11 @@ struct ServerOptions {
   double status_interval = 1.0;
   std::string dump_path;
   PhysicsParams physics;
+  // Network (not used by --bench, which never opens a socket).
+  std::string bind = "127.0.0.1";
+  std::uint16_t port = 7878;  // 0: an ephemeral port, printed at start
+  double snapshot_rate = 60.0;
+  std::uint32_t max_players = 8;
 };
 
 struct ParseResult {

@@ -29,6 +29,7 @@ void run_realtime(World& world, const LoopOptions& options, const std::atomic<bo
       sim_clock = now - kMaxLagSeconds;
     }
     const Clock::time_point busy_start = Clock::now();
+    if (options.at_step_boundary) options.at_step_boundary(world, status);
     while (sim_clock + dt <= now) {
       world.step();
       sim_clock += dt;

@@ -21,6 +21,10 @@ struct LoopOptions {
   double status_interval = 1.0;
   // Called on the loop's thread between steps, once per status interval.
   std::function<void(const World&, const LoopStatus&)> on_status;
+  // Called on the loop's thread at every step boundary where the loop wakes
+  // (at least every 2 ms), with the latest status: the one place where others
+  // may change the world (commands) or read it (snapshots).
+  std::function<void(World&, const LoopStatus&)> at_step_boundary;
 };
 
 void run_realtime(World& world, const LoopOptions& options, const std::atomic<bool>& stop);

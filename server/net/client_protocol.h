@@ -1,0 +1,65 @@
+#pragma once
+// The server's side of one conversation, without any I/O: what a received
+// frame or a physics reply means, and what to answer. Session (session.h)
+// feeds it bytes and carries out the outcome; the fuzzer feeds it directly.
+//
+//   awaiting_hello ──Hello(version ok)──► joining ──JoinedReply──► active
+//        │  anything else, bad version, broken stream: Error, then disconnect
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "protocol/frame_codec.h"
+#include "server/net/commands.h"
+
+namespace fishtank::net {
+
+// What every Welcome says about this server.
+struct ServerInfo {
+  std::string variant;  // "sse" or "scalar"
+  std::string simd;
+  std::uint32_t worker_threads = 1;
+  TankBounds tank;
+  float dt = 0.0f;
+  float snapshot_rate_hz = 60.0f;
+};
+
+struct Outcome {
+  std::vector<protocol::Frame> replies;  // to send, in order
+  std::optional<Command> command;        // for the physics thread
+  bool disconnect = false;               // after the replies are sent
+  std::string log;                       // worth a line in the server log when not empty
+};
+
+class ClientProtocol {
+ public:
+  ClientProtocol(std::uint32_t client_id, const ServerInfo& info) : client_id_(client_id), info_(info) {}
+
+  // A complete frame, length prefix included (decoded and checked here).
+  Outcome on_frame(const std::uint8_t* frame, std::size_t size);
+  // A length prefix that check_length_prefix() refused.
+  Outcome on_broken_stream(const protocol::DecodeResult& refused);
+  Outcome on_reply(const Reply& reply);
+  // The command of an Outcome could not be queued (the physics is behind).
+  Outcome on_queue_full();
+
+  // True from the Welcome on: the client gets snapshots.
+  bool welcomed() const { return state_ == State::active; }
+  const std::string& client_name() const { return name_; }
+
+ private:
+  enum class State { awaiting_hello, joining, active };
+
+  Outcome on_hello(const wire::Hello& hello);
+  Outcome on_message(const wire::Message& message);
+  Outcome refuse(wire::ErrorCode code, const std::string& why, bool disconnect);
+
+  std::uint32_t client_id_;
+  const ServerInfo& info_;
+  State state_ = State::awaiting_hello;
+  std::string name_;
+};
+
+}  // namespace fishtank::net

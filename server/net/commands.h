@@ -1,0 +1,81 @@
+#pragma once
+// What network threads ask of the physics thread, and what it answers.
+//
+//   io thread ──push(Command)──► CommandQueue ──drain()──► physics thread
+//   io thread ◄──post(Reply)─────────────────────────────── (at a step boundary)
+//
+// The queue is the only state both threads touch; its mutex is held for a
+// push_back or a swap, never while the world steps.
+
+#include <cstdint>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "common/vec3.h"
+
+namespace fishtank::net {
+
+struct JoinCommand {
+  bool wants_player = false;
+};
+struct LeaveCommand {};
+struct SetVelocityCommand {
+  Vec3 velocity;
+};
+struct AddBallsCommand {
+  std::uint32_t count = 0;
+};
+
+struct Command {
+  std::uint32_t client_id = 0;
+  std::variant<JoinCommand, LeaveCommand, SetVelocityCommand, AddBallsCommand> action;
+};
+
+struct JoinedReply {
+  std::optional<std::uint32_t> player_id;  // empty: no sphere (not asked for, or all taken)
+  std::string refusal;                     // why a sphere that was asked for was not given
+};
+struct BallsAddedReply {
+  std::uint32_t asked = 0;
+  std::uint32_t accepted = 0;
+  std::string refusal;  // empty when all were accepted
+};
+
+struct Reply {
+  std::uint32_t client_id = 0;
+  std::variant<JoinedReply, BallsAddedReply> result;
+};
+
+// Bounded, so a client flooding commands faster than the physics drains them
+// gets "server busy" instead of growing the server's memory.
+class CommandQueue {
+ public:
+  static constexpr std::size_t kCapacity = 4096;
+
+  // False when full (the command is dropped). Join and Leave are always
+  // accepted: a session's lifetime must reach the physics thread.
+  bool push(Command command) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const bool lifecycle =
+        std::holds_alternative<JoinCommand>(command.action) || std::holds_alternative<LeaveCommand>(command.action);
+    if (!lifecycle && commands_.size() >= kCapacity) return false;
+    commands_.push_back(std::move(command));
+    return true;
+  }
+
+  // Everything queued so far, in order; `out` is cleared first (reuse it to avoid allocations).
+  void drain(std::vector<Command>& out) {
+    out.clear();
+    std::lock_guard<std::mutex> lock(mutex_);
+    out.swap(commands_);
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<Command> commands_;
+};
+
+}  // namespace fishtank::net

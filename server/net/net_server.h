@@ -1,0 +1,60 @@
+#pragma once
+// The acceptor and the set of sessions, on the io thread.
+//
+//   acceptor ──► Session (one per connection) ──commands──► CommandQueue ──► physics thread
+//   physics thread ──post_snapshot / post_reply──► io thread ──► the sessions
+//
+// post_* are the only members called from another thread: they hand their
+// argument to the io thread with asio::post and return at once.
+
+#include <atomic>
+#include <boost/asio.hpp>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <unordered_map>
+
+#include "server/net/session.h"
+
+namespace fishtank::net {
+
+class NetServer final : public SessionOwner {
+ public:
+  NetServer(boost::asio::io_context& io, ServerInfo info, CommandQueue& commands);
+
+  // Binds and starts accepting; returns an error message, empty on success.
+  std::string listen(const std::string& address, std::uint16_t port);
+  boost::asio::ip::tcp::endpoint local_endpoint() const { return acceptor_.local_endpoint(); }
+  // Io thread: stop accepting and close every session.
+  void stop();
+
+  // Any thread.
+  void post_snapshot(SharedSnapshot snapshot);
+  void post_reply(Reply reply);
+  // Sessions that have been welcomed and so receive snapshots.
+  const std::atomic<int>& viewers() const { return viewers_; }
+  int clients() const { return clients_.load(std::memory_order_relaxed); }
+  std::uint64_t total_bytes_sent() const { return bytes_sent_.load(std::memory_order_relaxed); }
+
+  // SessionOwner (io thread)
+  bool submit(Command command) override;
+  void session_welcomed(Session& session) override;
+  void session_closed(Session& session) override;
+  void bytes_sent(std::size_t bytes) override;
+
+ private:
+  void do_accept();
+
+  boost::asio::io_context& io_;
+  boost::asio::ip::tcp::acceptor acceptor_;
+  ServerInfo info_;
+  CommandQueue& commands_;
+  std::unordered_map<std::uint32_t, std::shared_ptr<Session>> sessions_;
+  std::uint32_t next_client_id_ = 1;
+  bool stopped_ = false;
+  std::atomic<int> viewers_{0};
+  std::atomic<int> clients_{0};
+  std::atomic<std::uint64_t> bytes_sent_{0};
+};
+
+}  // namespace fishtank::net

@@ -1,0 +1,84 @@
+#include "server/net/network_service.h"
+
+#include <pthread.h>
+#include <time.h>
+
+#include <csignal>
+#include <cstdio>
+
+namespace fishtank::net {
+
+namespace {
+
+double cpu_seconds(clockid_t clock) {
+  timespec t{};
+  return clock_gettime(clock, &t) == 0 ? t.tv_sec + 1e-9 * t.tv_nsec : 0.0;
+}
+
+double thread_cpu_seconds(std::thread& thread) {
+  clockid_t clock;
+  return pthread_getcpuclockid(thread.native_handle(), &clock) == 0 ? cpu_seconds(clock) : 0.0;
+}
+
+}  // namespace
+
+NetworkService::NetworkService(const NetOptions& options, ServerInfo info, std::atomic<bool>& stop)
+    : options_(options),
+      work_(boost::asio::make_work_guard(io_)),
+      signals_(io_, SIGINT, SIGTERM),
+      server_(io_, std::move(info), commands_),
+      link_(
+          commands_, server_.viewers(), options.link, [this](Reply reply) { server_.post_reply(std::move(reply)); },
+          [this](SharedSnapshot snapshot) { server_.post_snapshot(std::move(snapshot)); }) {
+  signals_.async_wait([&stop](boost::system::error_code ec, int) {
+    if (!ec) stop = true;
+  });
+}
+
+std::string NetworkService::start() {
+  if (std::string error = server_.listen(options_.bind, options_.port); !error.empty()) return error;
+  const auto endpoint = server_.local_endpoint();
+  // Tests and scripts parse this line to find an ephemeral port.
+  std::fprintf(stderr, "listening on %s:%u\n", endpoint.address().to_string().c_str(), endpoint.port());
+  std::fflush(stderr);
+  io_thread_ = std::thread([this] { io_.run(); });
+  return {};
+}
+
+NetworkService::~NetworkService() {
+  boost::asio::post(io_, [this] {
+    server_.stop();
+    signals_.cancel();
+    work_.reset();
+  });
+  if (io_thread_.joinable()) io_thread_.join();
+}
+
+std::string NetworkService::status() {
+  const auto now = std::chrono::steady_clock::now();
+  const double window = std::chrono::duration<double>(now - last_status_).count();
+  const std::uint64_t bytes = server_.total_bytes_sent();
+  const double io_cpu = io_thread_.joinable() ? thread_cpu_seconds(io_thread_) : 0.0;
+  const double process_cpu = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID);
+  const SnapshotStats& snapshots = link_.snapshot_stats();
+
+  // Networking = the io thread plus snapshot encoding on the physics thread.
+  const double net_cpu = (io_cpu - last_io_cpu_) + (snapshots.encode_seconds - last_encode_seconds_);
+  const double process = process_cpu - last_process_cpu_;
+  const std::uint64_t encoded = snapshots.encoded - last_encoded_;
+  char line[256];
+  std::snprintf(line, sizeof line, "clients %d  out %.2f MB/s  net cpu %.1f %% of process  snapshot %zu B in %.0f us",
+                server_.clients(), window > 0.0 ? (bytes - last_bytes_) / window / 1e6 : 0.0,
+                process > 0.0 ? 100.0 * net_cpu / process : 0.0, snapshots.last_frame_bytes,
+                encoded ? 1e6 * (snapshots.encode_seconds - last_encode_seconds_) / encoded : 0.0);
+
+  last_status_ = now;
+  last_bytes_ = bytes;
+  last_io_cpu_ = io_cpu;
+  last_process_cpu_ = process_cpu;
+  last_encode_seconds_ = snapshots.encode_seconds;
+  last_encoded_ = snapshots.encoded;
+  return line;
+}
+
+}  // namespace fishtank::net

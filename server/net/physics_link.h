@@ -1,0 +1,64 @@
+#pragma once
+// The network's agent on the physics thread. Called by the realtime loop at
+// every step boundary, it
+//   1. applies the commands the sessions queued (join, leave, velocity, add balls)
+//      and hands each answer back to the io thread;
+//   2. encodes a snapshot when one is due (--snapshot-rate) and someone watches.
+// Nothing here runs on the io thread, so the world needs no lock.
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <unordered_map>
+#include <vector>
+
+#include "server/net/commands.h"
+#include "server/net/snapshot_encoder.h"
+#include "server/realtime_loop.h"
+
+namespace fishtank::net {
+
+struct PhysicsLinkOptions {
+  double snapshot_rate_hz = 60.0;
+  std::uint32_t max_players = 8;
+};
+
+// Measured on the physics thread; read there too (the status line).
+struct SnapshotStats {
+  std::uint64_t encoded = 0;
+  double encode_seconds = 0.0;  // total
+  std::size_t last_frame_bytes = 0;
+};
+
+class PhysicsLink {
+ public:
+  // reply and publish are called on the physics thread and must only hand
+  // their argument over to the io thread (post), never block.
+  PhysicsLink(CommandQueue& queue, const std::atomic<int>& viewers, PhysicsLinkOptions options,
+              std::function<void(Reply)> reply, std::function<void(SharedSnapshot)> publish);
+
+  void at_step_boundary(World& world, const LoopStatus& status);
+  const SnapshotStats& snapshot_stats() const { return stats_; }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+
+  void apply(World& world, const Command& command);
+  void publish_snapshot(const World& world, const LoopStatus& status);
+
+  CommandQueue& queue_;
+  const std::atomic<int>& viewers_;
+  PhysicsLinkOptions options_;
+  std::function<void(Reply)> reply_;
+  std::function<void(SharedSnapshot)> publish_;
+
+  std::vector<Command> drained_;
+  std::unordered_map<std::uint32_t, std::uint32_t> player_of_client_;
+  SnapshotEncoder encoder_;
+  std::uint32_t tick_ = 0;
+  Clock::time_point next_snapshot_ = Clock::now();
+  SnapshotStats stats_;
+};
+
+}  // namespace fishtank::net
