@@ -1,0 +1,211 @@
+#include "viewer/app.h"
+
+#include <GL/glew.h>
+#include <GLFW/glfw3.h>
+
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+#include "viewer/clock.h"
+#include "viewer/frame_stats.h"
+#include "viewer/hud.h"
+#include "viewer/input.h"
+#include "viewer/net/client.h"
+#include "viewer/net/interpolation.h"
+#include "viewer/net/snapshot_buffer.h"
+#include "viewer/render/camera.h"
+#include "viewer/render/screenshot.h"
+#include "viewer/render/sphere_renderer.h"
+#include "viewer/render/tank_outline.h"
+
+namespace fishtank::viewer {
+namespace {
+
+constexpr int kWindowWidth = 1280;  // SPEC 5.2
+constexpr int kWindowHeight = 1024;
+constexpr float kPlayerSpeed = 8.0f;  // m/s; the server clamps at its own maximum
+constexpr std::uint32_t kBallsPerPress = 1000;
+constexpr float kOutlineGrow = 1.35f;
+const std::array<std::uint8_t, 4> kOutlineRgba{255, 176, 32, 255};
+
+struct GlfwSession {
+  GlfwSession() { ok = glfwInit() == GLFW_TRUE; }
+  ~GlfwSession() {
+    if (ok) glfwTerminate();
+  }
+  bool ok;
+};
+
+bool same_box(const TankBounds& a, const TankBounds& b) {
+  return a.min.x == b.min.x && a.min.y == b.min.y && a.min.z == b.min.z && a.max.x == b.max.x &&
+         a.max.y == b.max.y && a.max.z == b.max.z;
+}
+
+void on_glfw_error(int code, const char* description) {
+  std::fprintf(stderr, "fishtank-viewer: GLFW error %d: %s\n", code, description);
+}
+
+class FullscreenToggle {
+ public:
+  explicit FullscreenToggle(GLFWwindow* window) : window_(window) {}
+  void toggle() {
+    if (glfwGetWindowMonitor(window_)) {
+      glfwSetWindowMonitor(window_, nullptr, x_, y_, kWindowWidth, kWindowHeight, 0);
+      return;
+    }
+    GLFWmonitor* monitor = glfwGetPrimaryMonitor();
+    if (!monitor) return;
+    glfwGetWindowPos(window_, &x_, &y_);
+    const GLFWvidmode* mode = glfwGetVideoMode(monitor);
+    glfwSetWindowMonitor(window_, monitor, 0, 0, mode->width, mode->height, mode->refreshRate);
+  }
+
+ private:
+  GLFWwindow* window_;
+  int x_ = 40, y_ = 40;  // where the window returns to
+};
+
+}  // namespace
+
+int run_viewer(const ViewerOptions& opt) {
+  glfwSetErrorCallback(on_glfw_error);
+  GlfwSession glfw;
+  if (!glfw.ok) {
+    std::fprintf(stderr, "fishtank-viewer: cannot open the display (is DISPLAY set?)\n");
+    return 1;
+  }
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);  // SPEC 5.2: 1280x1024 or full screen
+  const std::string title = "Fishtank - " + opt.host + ":" + opt.port;
+  GLFWwindow* window = glfwCreateWindow(kWindowWidth, kWindowHeight, title.c_str(), nullptr, nullptr);
+  if (!window) {
+    std::fprintf(stderr, "fishtank-viewer: cannot create a 1280x1024 OpenGL 3.3 core window\n");
+    return 1;
+  }
+  glfwMakeContextCurrent(window);
+  glfwSwapInterval(1);
+  glewExperimental = GL_TRUE;  // core profiles need it for GLEW 2.x to load every entry point
+  if (GLenum err = glewInit(); err != GLEW_OK) {
+    std::fprintf(stderr, "fishtank-viewer: GLEW: %s\n",
+                 reinterpret_cast<const char*>(glewGetErrorString(err)));
+    return 1;
+  }
+  FullscreenToggle fullscreen(window);
+  if (opt.fullscreen) fullscreen.toggle();
+
+  int exit_code = 0;
+  {
+    // Scope: every GL object is destroyed while the context still exists.
+    Input input(window);
+    Hud hud(window);
+    SphereRenderer spheres;
+    TankOutline tank_outline;
+    SnapshotBuffer snapshots;
+    NetClient net(opt.host, opt.port, !opt.observer, snapshots);
+    OrbitCamera camera;
+    camera.frame(TankBounds{});
+    FrameStats stats;
+
+    glEnable(GL_DEPTH_TEST);
+    glEnable(GL_CULL_FACE);
+    glClearColor(0.055f, 0.066f, 0.09f, 1.0f);
+
+    bool show_tank = false, show_help = false, show_stats = opt.hud;
+    std::vector<SphereInstance> instances;
+    TankBounds framed;  // the camera frames the tank again only if a server's tank differs
+    int frames_since_snapshot = 0;
+    const double started = steady_seconds();
+
+    while (!glfwWindowShouldClose(window)) {
+      glfwPollEvents();
+      const double frame_start = steady_seconds();
+
+      Actions a = input.take_actions();
+      if (a.quit) glfwSetWindowShouldClose(window, GLFW_TRUE);
+      if (a.toggle_tank) show_tank = !show_tank;
+      if (a.toggle_help) show_help = !show_help;
+      if (a.toggle_hud) show_stats = !show_stats;
+      if (a.toggle_fullscreen) fullscreen.toggle();
+      if (a.add_balls) net.add_balls(kBallsPerPress);
+
+      input.drive_camera(camera);
+      if (!opt.observer) net.set_velocity(input.movement(camera) * kPlayerSpeed);
+
+      // The pair first, then the status: a snapshot of a new connection is
+      // only ever pushed after that connection's status (and ball kinds).
+      RenderPair pair;
+      const bool have_frame = snapshots.frame_at(frame_start, pair);
+      const ConnectionStatus status = net.status();
+      int own = -1;
+      instances.clear();
+      if (have_frame && status.info) {
+        const TankBounds& tank = status.info->tank;
+        if (!same_box(framed, tank)) {
+          camera.frame(tank);
+          tank_outline.set_bounds(tank);
+          framed = tank;
+        }
+        own = interpolate(pair, *status.info, instances);
+      }
+
+      HudView view;
+      view.fps = stats.fps();
+      view.frame_ms = stats.frame_ms();
+      view.cpu_ms = stats.cpu_ms();
+      view.net = &status;
+      const std::shared_ptr<const Snapshot> newest = snapshots.newest();
+      view.snapshot = newest.get();
+      view.render_delay_ms = static_cast<float>(1e3 * snapshots.render_delay());
+      view.observer = opt.observer;
+      view.show_stats = show_stats;
+      view.show_help = show_help;
+      view.now = frame_start;
+      hud.build(view);
+      const double cpu_seconds = steady_seconds() - frame_start;
+
+      int width = 0, height = 0;
+      glfwGetFramebufferSize(window, &width, &height);
+      glViewport(0, 0, width, height);
+      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+      const Mat4 view_proj = camera.view_projection(height > 0 ? static_cast<float>(width) / height : 1.0f);
+      spheres.draw(view_proj, instances);
+      if (own >= 0) {
+        SphereInstance ring = instances[static_cast<std::size_t>(own)];
+        ring.rgba = kOutlineRgba;
+        spheres.draw_outline(view_proj, ring, kOutlineGrow);
+      }
+      if (show_tank) tank_outline.draw(view_proj);
+      hud.render();
+
+      if (!opt.screenshot.empty()) {
+        if (have_frame && ++frames_since_snapshot >= opt.frames) {
+          if (!save_screenshot(opt.screenshot, width, height)) exit_code = 1;
+          glfwSetWindowShouldClose(window, GLFW_TRUE);
+        } else if (!have_frame && frame_start - started > opt.screenshot_timeout) {
+          std::fprintf(stderr, "fishtank-viewer: no snapshot from %s within %.0f s: %s\n",
+                       status.endpoint.c_str(), opt.screenshot_timeout, status.last_error.c_str());
+          exit_code = 1;
+          glfwSetWindowShouldClose(window, GLFW_TRUE);
+        }
+      }
+      glfwSwapBuffers(window);
+      stats.frame_done(steady_seconds(), cpu_seconds);
+    }
+
+    const std::shared_ptr<const Snapshot> last = snapshots.newest();
+    std::fprintf(
+        stderr,
+        "fishtank-viewer: %llu frames in %.2f s (%.1f fps), %.3f ms CPU per frame outside GL, %u balls\n",
+        static_cast<unsigned long long>(stats.total_frames()), stats.total_seconds(),
+        stats.total_seconds() > 0.0 ? (stats.total_frames() - 1) / stats.total_seconds() : 0.0,
+        stats.mean_cpu_ms(), last ? last->ball_count : 0u);
+  }
+  glfwDestroyWindow(window);
+  return exit_code;
+}
+
+}  // namespace fishtank::viewer

@@ -1,0 +1,27 @@
+#pragma once
+// The viewer's main thread: the window, the frame loop, and the wiring of
+// net client, interpolation, renderers, HUD and input.
+//
+// One frame:  poll input ► pick the snapshot pair for now ► interpolate into
+// instances ► lay out the HUD ─ (CPU above, GL below) ─► draw spheres, outline,
+// tank edges, HUD ► swap.
+
+#include <string>
+
+namespace fishtank::viewer {
+
+struct ViewerOptions {
+  std::string host = "127.0.0.1";
+  std::string port = "7878";
+  bool fullscreen = false;
+  bool observer = false;  // no player sphere of our own
+  bool hud = true;
+  std::string screenshot;  // non-empty: save this PNG after `frames` frames, then exit
+  int frames = 1;
+  double screenshot_timeout = 30.0;  // seconds to wait for the first snapshot
+};
+
+// Returns the process exit code.
+int run_viewer(const ViewerOptions& options);
+
+}  // namespace fishtank::viewer

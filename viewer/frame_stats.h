@@ -1,0 +1,38 @@
+#pragma once
+// Frame rate, frame time and CPU time per frame, each measured over the last
+// second of real frames (SPEC 5.1: measured, not estimated), plus totals for
+// the summary printed at exit.
+
+#include <cstdint>
+#include <deque>
+
+namespace fishtank::viewer {
+
+class FrameStats {
+ public:
+  // Once per frame: when it ended, and the CPU seconds it spent outside GL calls.
+  void frame_done(double now, double cpu_seconds);
+
+  float fps() const { return fps_; }
+  float frame_ms() const { return frame_ms_; }
+  float cpu_ms() const { return cpu_ms_; }
+
+  std::uint64_t total_frames() const { return total_frames_; }
+  double total_seconds() const { return last_ - first_; }
+  double mean_cpu_ms() const {
+    return total_frames_ ? 1e3 * total_cpu_ / static_cast<double>(total_frames_) : 0.0;
+  }
+
+ private:
+  struct Sample {
+    double end;
+    double cpu;
+  };
+  std::deque<Sample> window_;  // frames that ended in the last second
+  float fps_ = 0.0f, frame_ms_ = 0.0f, cpu_ms_ = 0.0f;
+  std::uint64_t total_frames_ = 0;
+  double total_cpu_ = 0.0;
+  double first_ = 0.0, last_ = 0.0;
+};
+
+}  // namespace fishtank::viewer

@@ -1,0 +1,162 @@
+#include "viewer/hud.h"
+
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+
+#include <cstdarg>
+#include <cstdio>
+
+namespace fishtank::viewer {
+namespace {
+
+// Debian's fonts-dejavu-core (scripts/install-deps viewer). ImGui's built-in
+// font is drawn for 13 pixels and small on a 1280x1024 screen; it is the
+// fallback where DejaVu is missing.
+constexpr const char* kFontPath = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+constexpr float kFontPixels = 17.0f;
+constexpr double kNoticeSeconds = 6.0;
+
+const ImVec4 kDim{0.65f, 0.70f, 0.78f, 1.0f};
+const ImVec4 kWarn{1.0f, 0.55f, 0.35f, 1.0f};
+
+void row(const char* label, const char* fmt, ...) IM_FMTARGS(2);
+void row(const char* label, const char* fmt, ...) {
+  ImGui::TextColored(kDim, "%s", label);
+  ImGui::SameLine(110.0f);
+  va_list args;
+  va_start(args, fmt);
+  ImGui::TextV(fmt, args);
+  va_end(args);
+}
+
+}  // namespace
+
+Hud::Hud(GLFWwindow* window) {
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGuiIO& io = ImGui::GetIO();
+  io.IniFilename = nullptr;  // no imgui.ini next to wherever the viewer was started
+  if (std::FILE* f = std::fopen(kFontPath, "rb")) {
+    std::fclose(f);
+    io.Fonts->AddFontFromFileTTF(kFontPath, kFontPixels);
+  } else {
+    io.FontGlobalScale = 1.3f;
+  }
+  ImGui::StyleColorsDark();
+  ImGui::GetStyle().WindowRounding = 4.0f;
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init("#version 330 core");
+}
+
+Hud::~Hud() {
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+}
+
+void Hud::build(const HudView& v) {
+  ImGui_ImplOpenGL3_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+  if (v.show_stats) stats(v);
+  connection(v);
+  if (v.show_help) help();
+  ImGui::Render();
+}
+
+void Hud::render() { ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData()); }
+
+void Hud::stats(const HudView& v) {
+  const ConnectionStatus& net = *v.net;
+  ImGui::SetNextWindowPos({12.0f, 12.0f});
+  ImGui::SetNextWindowBgAlpha(0.55f);
+  ImGui::Begin("stats", nullptr,
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                   ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoMove);
+  row("Frames", "%.1f fps   %.2f ms/frame", v.fps, v.frame_ms);
+  row("CPU", "%.2f ms/frame outside GL", v.cpu_ms);
+  if (const Snapshot* s = v.snapshot) {
+    row("Physics", "%.0f steps/s   load %.0f %%", s->steps_per_s, 100.0f * s->load);
+    row("Balls", "%u", s->ball_count);
+  } else {
+    row("Physics", "-");
+    row("Balls", "-");
+  }
+  if (const ServerInfo* info = net.info.get())
+    row("Server", "%s (SIMD %s), %d worker thread%s", info->variant.c_str(), info->simd.c_str(),
+        info->threads, info->threads == 1 ? "" : "s");
+  else
+    row("Server", "%s", net.endpoint.c_str());
+  row("Snapshots", "%.1f /s   render delay %.0f ms", net.snapshots_per_s, v.render_delay_ms);
+  row("Bandwidth", "%.1f KiB/s in", net.bytes_per_s / 1024.0f);
+  if (net.rtt_ms >= 0.0f)
+    row("Round trip", "%.2f ms", net.rtt_ms);
+  else
+    row("Round trip", "-");
+  if (v.observer || (net.info && !net.info->has_player))
+    row("Player", "observing");
+  else
+    row("Player", "yours is the white sphere with the amber ring");
+  ImGui::TextColored(kDim, "H: help");
+  if (!net.notice.empty() && v.now - net.notice_time < kNoticeSeconds) {
+    ImGui::PushTextWrapPos(520.0f);
+    ImGui::TextColored(kWarn, "%s", net.notice.c_str());
+    ImGui::PopTextWrapPos();
+  }
+  ImGui::End();
+}
+
+void Hud::connection(const HudView& v) {
+  const ConnectionStatus& net = *v.net;
+  if (net.state == ConnectionStatus::State::connected) return;
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  ImGui::SetNextWindowPos({vp->WorkPos.x + vp->WorkSize.x * 0.5f, vp->WorkPos.y + vp->WorkSize.y * 0.4f},
+                          ImGuiCond_Always, {0.5f, 0.5f});
+  ImGui::SetNextWindowBgAlpha(0.8f);
+  ImGui::Begin("connection", nullptr,
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoNav |
+                   ImGuiWindowFlags_NoMove);
+  ImGui::SetWindowFontScale(1.5f);
+  if (net.state == ConnectionStatus::State::connecting && net.last_error.empty()) {
+    ImGui::Text("Connecting to %s ...", net.endpoint.c_str());
+  } else {
+    ImGui::TextColored(kWarn, "No connection to the server at %s", net.endpoint.c_str());
+    ImGui::SetWindowFontScale(1.0f);
+    ImGui::Text("%s", net.last_error.c_str());
+    ImGui::Text("Retrying every second (attempt %d). Start one with: build/server/fishtank-server",
+                net.attempt);
+  }
+  ImGui::End();
+}
+
+void Hud::help() {
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  ImGui::SetNextWindowPos({vp->WorkPos.x + vp->WorkSize.x * 0.5f, vp->WorkPos.y + vp->WorkSize.y * 0.5f},
+                          ImGuiCond_Always, {0.5f, 0.5f});
+  ImGui::SetNextWindowBgAlpha(0.85f);
+  ImGui::Begin("Controls", nullptr,
+               ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove);
+  static constexpr const char* kControls[][2] = {
+      {"W / S", "move your sphere forward / back (away from / towards the camera)"},
+      {"A / D", "move your sphere left / right"},
+      {"E or Space", "move your sphere up"},
+      {"Q or Shift", "move your sphere down"},
+      {"Left-drag", "orbit the camera around the tank"},
+      {"Wheel", "zoom in / out"},
+      {"B", "pour 1000 more balls in from the top"},
+      {"T", "show / hide the tank's edges"},
+      {"F1", "show / hide the statistics"},
+      {"F11", "full screen on / off"},
+      {"H", "show / hide this help"},
+      {"Esc", "quit"},
+  };
+  for (const auto& c : kControls) {
+    ImGui::TextColored(kDim, "%s", c[0]);
+    ImGui::SameLine(130.0f);
+    ImGui::TextUnformatted(c[1]);
+  }
+  ImGui::End();
+}
+
+}  // namespace fishtank::viewer

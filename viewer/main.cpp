@@ -1,0 +1,54 @@
+// fishtank-viewer: flags, then the viewer's loop (viewer/app.cpp). Nothing else.
+
+#include <boost/program_options.hpp>
+#include <cstdio>
+#include <iostream>
+#include <string>
+
+#include "viewer/app.h"
+
+namespace po = boost::program_options;
+
+int main(int argc, char** argv) {
+  fishtank::viewer::ViewerOptions opt;
+  std::string connect = opt.host + ":" + opt.port;
+  po::options_description flags(
+      "fishtank-viewer: shows a fishtank-server's simulation and steers a player sphere in it.\n"
+      "Usage: fishtank-viewer [--connect host:port] [--fullscreen] [--observer]\n"
+      "Keys: H shows every control in the window.\n\nOptions");
+  flags.add_options()                                                                               //
+      ("help", "print this help and exit")                                                          //
+      ("connect", po::value(&connect), "server to connect to, host:port (default 127.0.0.1:7878)")  //
+      ("fullscreen", po::bool_switch(&opt.fullscreen), "start in full screen (F11 toggles)")        //
+      ("observer", po::bool_switch(&opt.observer), "watch only: no player sphere of our own")       //
+      ("no-hud", "start with the statistics hidden (F1 toggles)")                                   //
+      ("screenshot", po::value(&opt.screenshot),
+       "render --frames frames after the first snapshot, save them "
+       "as this PNG file and exit")  //
+      ("frames", po::value(&opt.frames), "frames to render before --screenshot (default 1)");
+  po::variables_map vm;
+  try {
+    po::store(po::parse_command_line(argc, argv, flags), vm);
+    po::notify(vm);
+  } catch (const po::error& e) {
+    std::fprintf(stderr, "fishtank-viewer: %s (see --help)\n", e.what());
+    return 2;
+  }
+  if (vm.count("help")) {
+    std::cout << flags << "\n";
+    return 0;
+  }
+  opt.hud = vm.count("no-hud") == 0;
+  const auto colon = connect.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == connect.size()) {
+    std::fprintf(stderr, "fishtank-viewer: --connect wants host:port, got '%s'\n", connect.c_str());
+    return 2;
+  }
+  opt.host = connect.substr(0, colon);
+  opt.port = connect.substr(colon + 1);
+  if (opt.frames < 1) {
+    std::fprintf(stderr, "fishtank-viewer: --frames must be at least 1\n");
+    return 2;
+  }
+  return fishtank::viewer::run_viewer(opt);
+}

@@ -1,0 +1,49 @@
+#pragma once
+// What the viewer keeps of the server's messages, decoded from FlatBuffers by
+// the net thread into plain structs that the render thread reads without
+// knowing the wire format.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "common/tank.h"
+
+namespace fishtank::viewer {
+
+// From Welcome: fixed for the life of one connection.
+struct ServerInfo {
+  std::string variant;  // "sse" or "scalar"
+  std::string simd;     // e.g. "sse4.1"
+  int threads = 0;
+  TankBounds tank;
+  float dt = 0.0f;
+  std::vector<BallKind> kinds;  // indexed by a ball's kind number
+  std::uint32_t client_id = 0;
+  std::uint32_t player_id = 0;
+  bool has_player = false;
+};
+
+struct PlayerState {
+  std::uint32_t id;
+  Vec3 pos;
+};
+
+struct Snapshot {
+  std::uint64_t tick = 0;
+  double sim_time = 0.0;  // server seconds
+  double received = 0.0;  // local steady-clock seconds, when it arrived
+  float steps_per_s = 0.0f;
+  float load = 0.0f;
+  std::uint32_t ball_count = 0;
+  // x, y, z per ball in id order, each 0..65535 over the tank bounds.
+  std::vector<std::uint16_t> quantised;
+  // Kind of every ball so far, id order. Shared between snapshots and copied
+  // only when new balls appear (sizes are sent once per ball, SPEC 3.6).
+  std::shared_ptr<const std::vector<std::uint8_t>> kinds;
+  std::vector<PlayerState> players;
+};
+
+}  // namespace fishtank::viewer
