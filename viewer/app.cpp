@@ -114,7 +114,7 @@ int run_viewer(const ViewerOptions& opt) {
     glEnable(GL_CULL_FACE);
     glClearColor(0.055f, 0.066f, 0.09f, 1.0f);
 
-    bool show_tank = false, show_help = false, show_stats = opt.hud;
+    bool show_tank = opt.tank_outline, show_help = false, show_stats = opt.hud;
     std::vector<SphereInstance> instances;
     TankBounds framed;  // the camera frames the tank again only if a server's tank differs
     int frames_since_snapshot = 0;

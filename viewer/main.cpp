@@ -16,12 +16,13 @@ int main(int argc, char** argv) {
       "fishtank-viewer: shows a fishtank-server's simulation and steers a player sphere in it.\n"
       "Usage: fishtank-viewer [--connect host:port] [--fullscreen] [--observer]\n"
       "Keys: H shows every control in the window.\n\nOptions");
-  flags.add_options()                                                                               //
-      ("help", "print this help and exit")                                                          //
-      ("connect", po::value(&connect), "server to connect to, host:port (default 127.0.0.1:7878)")  //
-      ("fullscreen", po::bool_switch(&opt.fullscreen), "start in full screen (F11 toggles)")        //
-      ("observer", po::bool_switch(&opt.observer), "watch only: no player sphere of our own")       //
-      ("no-hud", "start with the statistics hidden (F1 toggles)")                                   //
+  flags.add_options()                                                                                   //
+      ("help", "print this help and exit")                                                              //
+      ("connect", po::value(&connect), "server to connect to, host:port (default 127.0.0.1:7878)")      //
+      ("fullscreen", po::bool_switch(&opt.fullscreen), "start in full screen (F11 toggles)")            //
+      ("observer", po::bool_switch(&opt.observer), "watch only: no player sphere of our own")           //
+      ("no-hud", "start with the statistics hidden (F1 toggles)")                                       //
+      ("outline", po::bool_switch(&opt.tank_outline), "start with the tank's edges shown (T toggles)")  //
       ("screenshot", po::value(&opt.screenshot),
        "render --frames frames after the first snapshot, save them "
        "as this PNG file and exit")  //

@@ -16,10 +16,10 @@ void OrbitCamera::frame(const TankBounds& tank) {
   Vec3 size = tank.size();
   // Aim a little below the centre: the pile sits on the floor, and from above
   // the floor would otherwise crowd the bottom of the picture.
-  target_ = tank.min + Vec3{size.x * 0.5f, size.y * 0.42f, size.z * 0.5f};
+  target_ = tank.min + Vec3{size.x * 0.5f, size.y * 0.45f, size.z * 0.5f};
   // The bounding sphere of the box fits the vertical field of view.
   float radius = 0.5f * length(size);
-  distance_ = radius / std::sin(kFovY * 0.5f) * 0.92f;
+  distance_ = radius / std::sin(kFovY * 0.5f);
   min_distance_ = 0.05f * radius;
   max_distance_ = 6.0f * radius;
   yaw_ = 0.0f;

@@ -1,0 +1,24 @@
+// The frame-rate counter is measured over the last second of real frames (SPEC 5.1).
+
+#include "viewer/frame_stats.h"
+
+#include <catch2/catch.hpp>
+
+using fishtank::viewer::FrameStats;
+
+TEST_CASE("frames every 1/60 s read as 60 fps and 16.7 ms, CPU time as the mean per frame") {
+  FrameStats stats;
+  for (int i = 0; i <= 120; ++i) stats.frame_done(i / 60.0, 0.002);
+  CHECK(stats.fps() == Approx(60.0f).epsilon(1e-3));
+  CHECK(stats.frame_ms() == Approx(1000.0f / 60.0f).epsilon(1e-3));
+  CHECK(stats.cpu_ms() == Approx(2.0f).epsilon(1e-3));
+  CHECK(stats.total_frames() == 121);
+}
+
+TEST_CASE("the counter follows a change of rate within a second") {
+  FrameStats stats;
+  double t = 0.0;
+  for (int i = 0; i < 120; ++i) stats.frame_done(t += 1.0 / 60.0, 0.0);
+  for (int i = 0; i < 25; ++i) stats.frame_done(t += 1.0 / 20.0, 0.0);  // 1.25 s at 20 fps
+  CHECK(stats.fps() == Approx(20.0f).epsilon(1e-3));
+}

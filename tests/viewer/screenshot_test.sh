@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# The viewer for real (DESIGN "Tests"): a server on an ephemeral loopback
+# port, the viewer under Xvfb with Mesa's software OpenGL rendering frames and
+# saving a PNG, then the pixel check. Exit 77 (skipped) only without xvfb-run.
+#
+# Usage: screenshot_test.sh SERVER VIEWER CHECKER OUT_DIR
+set -euo pipefail
+server=$1 viewer=$2 checker=$3 out=$4
+
+if ! command -v xvfb-run >/dev/null; then
+  echo "xvfb-run is not installed (scripts/install-deps viewer installs it): skipped"
+  exit 77
+fi
+mkdir -p "$out"
+png=$out/viewer_screenshot.png
+log=$out/server.log
+rm -f "$png"
+
+"$server" --port 0 --balls 1000 2>"$log" &
+server_pid=$!
+trap 'kill "$server_pid" 2>/dev/null || true; wait "$server_pid" 2>/dev/null || true' EXIT
+
+port=""
+for _ in $(seq 200); do
+  port=$(sed -n 's/^listening on .*:\([0-9][0-9]*\)$/\1/p' "$log")
+  [ -n "$port" ] && break
+  kill -0 "$server_pid" 2>/dev/null || break
+  sleep 0.05
+done
+if [ -z "$port" ]; then
+  echo "the server did not report its port:"
+  cat "$log"
+  exit 1
+fi
+
+timeout 150 xvfb-run -a -s "-screen 0 1280x1024x24" \
+  "$viewer" --connect "127.0.0.1:$port" --no-hud --screenshot "$png" --frames 60
+"$checker" "$png"
