@@ -163,9 +163,11 @@ Frame encode_snapshot(const SnapshotHeader& header, const std::uint16_t* quantis
   flatbuffers::FlatBufferBuilder b(256 + 2 * values + 16 * players);
   const auto positions = b.CreateVector(quantised, values);
   const auto ids = b.CreateVector(player_ids, players);
-  wire::Vec3f* player_out = nullptr;
-  const auto player_offset = b.CreateUninitializedVectorOfStructs(players, &player_out);
-  for (std::size_t i = 0; i < players; ++i) player_out[i] = to_wire(player_positions[i]);
+  // Not CreateUninitializedVectorOfStructs: in FlatBuffers 2.0.8 it aligns a
+  // 12-byte struct to 12 bytes, which corrupts the buffer.
+  std::vector<wire::Vec3f> player_wire(players);
+  for (std::size_t i = 0; i < players; ++i) player_wire[i] = to_wire(player_positions[i]);
+  const auto player_offset = b.CreateVectorOfStructs(player_wire);
   return finish(b, wire::CreateSnapshot(b, header.tick, header.sim_time, header.physics_steps, header.steps_per_s,
                                         header.load, ball_count, positions, ids, player_offset));
 }

@@ -91,10 +91,8 @@ Outcome ClientProtocol::on_reply(const Reply& reply) {
   }
   const auto& added = std::get<BallsAddedReply>(reply.result);
   if (added.refusal.empty()) return out;
-  return refuse(
-      wire::ErrorCode::tank_full,
-      "added " + std::to_string(added.accepted) + " of " + std::to_string(added.asked) + " balls: " + added.refusal,
-      /*disconnect=*/false);
+  // World::add_balls's refusal already says how many were added and why no more.
+  return refuse(wire::ErrorCode::tank_full, added.refusal, /*disconnect=*/false);
 }
 
 Outcome ClientProtocol::on_queue_full() {

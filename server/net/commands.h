@@ -39,9 +39,7 @@ struct JoinedReply {
   std::string refusal;                     // why a sphere that was asked for was not given
 };
 struct BallsAddedReply {
-  std::uint32_t asked = 0;
-  std::uint32_t accepted = 0;
-  std::string refusal;  // empty when all were accepted
+  std::string refusal;  // empty when all were accepted; else how many were and why no more
 };
 
 struct Reply {

@@ -59,7 +59,7 @@ void PhysicsLink::apply(World& world, const Command& command) {
                  },
                  [&](const AddBallsCommand& add) {
                    AddResult added = world.add_balls(add.count);
-                   reply_({client, BallsAddedReply{add.count, added.accepted, std::move(added.refusal)}});
+                   reply_({client, BallsAddedReply{std::move(added.refusal)}});
                  },
              },
              command.action);

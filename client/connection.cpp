@@ -1,0 +1,147 @@
+#include "client/connection.h"
+
+#include "protocol/quantize.h"
+
+namespace fishtank::client {
+
+namespace asio = boost::asio;
+
+Connection::Connection(asio::io_context& io, std::string name, bool wants_player)
+    : socket_(io), name_(std::move(name)), wants_player_(wants_player) {}
+
+void Connection::start(const asio::ip::tcp::endpoint& server, std::uint32_t version) {
+  socket_.async_connect(server, [this, self = shared_from_this(), version](boost::system::error_code ec) {
+    if (ec) return fail("cannot connect: " + ec.message());
+    boost::system::error_code ignored;
+    socket_.set_option(asio::ip::tcp::no_delay(true), ignored);
+    send(protocol::encode_hello(name_, wants_player_, version));
+    do_read();
+  });
+}
+
+void Connection::send(protocol::Frame frame) {
+  if (closed_) return;
+  outgoing_.push_back(std::move(frame));
+  do_write();
+}
+
+void Connection::send_ping() {
+  const auto us = std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - epoch_);
+  send(protocol::encode_ping(static_cast<std::uint32_t>(us.count())));
+}
+
+void Connection::close() {
+  if (closed_) return;
+  closed_ = true;
+  if (close_reason_.empty()) close_reason_ = "closed by the client";
+  boost::system::error_code ignored;
+  socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
+  socket_.close(ignored);
+}
+
+void Connection::fail(const std::string& reason) {
+  if (close_reason_.empty()) close_reason_ = reason;
+  close();
+}
+
+void Connection::do_write() {
+  if (write_in_flight_ || outgoing_.empty() || !socket_.is_open()) return;
+  write_in_flight_ = true;
+  asio::async_write(socket_, asio::buffer(outgoing_.front()),
+                    [this, self = shared_from_this()](boost::system::error_code ec, std::size_t) {
+                      write_in_flight_ = false;
+                      if (ec) return fail(ec == asio::error::operation_aborted ? "" : "write failed: " + ec.message());
+                      outgoing_.pop_front();
+                      do_write();
+                    });
+}
+
+void Connection::do_read() {
+  socket_.async_read_some(asio::buffer(read_buffer_),
+                          [this, self = shared_from_this()](boost::system::error_code ec, std::size_t n) {
+                            if (ec)
+                              return fail(ec == asio::error::eof ? "the server closed the connection" : ec.message());
+                            stats_.bytes_received += n;
+                            reader_.append(read_buffer_.data(), n);
+                            while (std::optional<protocol::DecodeResult> frame = reader_.next()) {
+                              if (!frame->ok()) {
+                                stats_.errors.push_back("bad frame from the server: " + frame->why);
+                                if (frame->stream_broken()) return fail("bad frame from the server: " + frame->why);
+                                continue;
+                              }
+                              handle(*frame->message);
+                            }
+                            if (!closed_) do_read();
+                          });
+}
+
+void Connection::handle(const wire::Message& message) {
+  switch (message.payload_type()) {
+    case wire::Payload::Welcome: {
+      const wire::Welcome& w = *message.payload_as_Welcome();
+      welcomed_ = true;
+      if (w.has_player()) player_id_ = w.player_id();
+      tank_.min = {w.tank_min()->x(), w.tank_min()->y(), w.tank_min()->z()};
+      tank_.max = {w.tank_max()->x(), w.tank_max()->y(), w.tank_max()->z()};
+      break;
+    }
+    case wire::Payload::BallKinds: {
+      const wire::BallKinds& k = *message.payload_as_BallKinds();
+      if (k.first_new_ball() != view_.kinds.size())
+        stats_.errors.push_back("BallKinds starts at ball " + std::to_string(k.first_new_ball()) + ", expected " +
+                                std::to_string(view_.kinds.size()));
+      view_.kinds.resize(k.first_new_ball());
+      view_.kinds.insert(view_.kinds.end(), k.kinds()->begin(), k.kinds()->end());
+      break;
+    }
+    case wire::Payload::Snapshot: {
+      const wire::Snapshot& s = *message.payload_as_Snapshot();
+      if (stats_.snapshots > 0 && s.tick() > view_.tick + 1) stats_.skipped_snapshots += s.tick() - view_.tick - 1;
+      if (s.ball_count() > view_.kinds.size())
+        stats_.errors.push_back("Snapshot has " + std::to_string(s.ball_count()) + " balls but kinds of only " +
+                                std::to_string(view_.kinds.size()) + " were sent");
+      view_.tick = s.tick();
+      view_.sim_time = s.sim_time();
+      view_.ball_count = s.ball_count();
+      view_.positions.assign(s.positions()->begin(), s.positions()->end());
+      view_.player_ids.clear();
+      view_.player_positions.clear();
+      if (s.player_ids())
+        for (std::uint32_t i = 0; i < s.player_ids()->size(); ++i) {
+          const wire::Vec3f* p = s.player_positions()->Get(i);
+          view_.player_ids.push_back(s.player_ids()->Get(i));
+          view_.player_positions.push_back({p->x(), p->y(), p->z()});
+        }
+      const auto now = std::chrono::steady_clock::now();
+      if (!stats_.first_snapshot) stats_.first_snapshot = now;
+      stats_.last_snapshot = now;
+      ++stats_.snapshots;
+      break;
+    }
+    case wire::Payload::Error: {
+      const wire::Error& e = *message.payload_as_Error();
+      stats_.errors.push_back(std::string(wire::EnumNameErrorCode(e.code())) + ": " + e.message()->str());
+      break;
+    }
+    case wire::Payload::Pong: {
+      const auto now_us = static_cast<std::uint32_t>(
+          std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - epoch_).count());
+      stats_.rtt_ms.push_back(1e-3 * static_cast<std::uint32_t>(now_us - message.payload_as_Pong()->client_time_us()));
+      break;
+    }
+    default:  // decode_frame accepts only server messages in this direction
+      break;
+  }
+}
+
+std::optional<Vec3> Connection::player_position(std::uint32_t player_id) const {
+  for (std::size_t i = 0; i < view_.player_ids.size(); ++i)
+    if (view_.player_ids[i] == player_id) return view_.player_positions[i];
+  return std::nullopt;
+}
+
+Vec3 Connection::ball_position(std::uint32_t ball_id) const {
+  return protocol::dequantize_position(&view_.positions.at(3 * std::size_t{ball_id}), tank_);
+}
+
+}  // namespace fishtank::client

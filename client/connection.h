@@ -1,0 +1,85 @@
+#pragma once
+// One client connection to a fishtank-server, on a caller-owned io_context
+// (several connections can share one thread). It says Hello, keeps the newest
+// snapshot's state and counts what it receives; writes are queued, one in flight.
+// Used by fishtank-client and by the network tests.
+
+#include <boost/asio.hpp>
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "protocol/frame_codec.h"
+
+namespace fishtank::client {
+
+struct ConnectionStats {
+  std::uint64_t snapshots = 0;
+  std::uint64_t bytes_received = 0;
+  std::uint64_t skipped_snapshots = 0;  // gaps in Snapshot.tick
+  std::vector<double> rtt_ms;           // one per Pong
+  std::vector<std::string> errors;      // Error messages, "code: message"
+  std::optional<std::chrono::steady_clock::time_point> first_snapshot, last_snapshot;
+};
+
+// What the newest snapshot said.
+struct WorldView {
+  std::uint32_t tick = 0;
+  double sim_time = 0.0;
+  std::uint32_t ball_count = 0;
+  std::vector<std::uint16_t> positions;  // quantised, 3 per ball (protocol/quantize.h)
+  std::vector<std::uint8_t> kinds;       // by ball id, from BallKinds
+  std::vector<std::uint32_t> player_ids;
+  std::vector<Vec3> player_positions;
+};
+
+class Connection : public std::enable_shared_from_this<Connection> {
+ public:
+  Connection(boost::asio::io_context& io, std::string name, bool wants_player);
+
+  // Connects, then sends Hello (with this protocol version unless told otherwise).
+  void start(const boost::asio::ip::tcp::endpoint& server, std::uint32_t version = protocol::kProtocolVersion);
+  void send(protocol::Frame frame);
+  void send_ping();
+  void close();
+
+  bool welcomed() const { return welcomed_; }
+  bool closed() const { return closed_; }
+  const std::string& close_reason() const { return close_reason_; }
+  std::optional<std::uint32_t> player_id() const { return player_id_; }
+  const TankBounds& tank() const { return tank_; }
+  const ConnectionStats& stats() const { return stats_; }
+  const WorldView& view() const { return view_; }
+  // The newest position of a player sphere, if the newest snapshot has it.
+  std::optional<Vec3> player_position(std::uint32_t player_id) const;
+  Vec3 ball_position(std::uint32_t ball_id) const;
+
+ private:
+  void do_read();
+  void handle(const wire::Message& message);
+  void do_write();
+  void fail(const std::string& reason);
+
+  boost::asio::ip::tcp::socket socket_;
+  std::string name_;
+  bool wants_player_;
+  protocol::FrameReader reader_{protocol::Direction::to_client};
+  std::vector<std::uint8_t> read_buffer_ = std::vector<std::uint8_t>(64 * 1024);
+  std::deque<protocol::Frame> outgoing_;
+  bool write_in_flight_ = false;
+
+  bool welcomed_ = false;
+  bool closed_ = false;
+  std::string close_reason_;
+  std::optional<std::uint32_t> player_id_;
+  TankBounds tank_;
+  ConnectionStats stats_;
+  WorldView view_;
+  std::chrono::steady_clock::time_point epoch_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace fishtank::client

@@ -1,0 +1,39 @@
+// fishtank-client: a scripted test and load client (see --help).
+
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "client/options.h"
+
+int main(int argc, char** argv) {
+  const fishtank::client::ClientParse parsed = fishtank::client::parse_client_options(argc, argv);
+  if (!parsed.options) {
+    (parsed.exit_code == 0 ? std::cout : std::cerr) << parsed.message << "\n";
+    return parsed.exit_code;
+  }
+  const fishtank::client::ClientOptions& o = *parsed.options;
+  const fishtank::client::Summary s = fishtank::client::run_script(o.script);
+  if (!s.connect_error.empty()) {
+    std::cerr << "fishtank-client: no connection to " << o.script.host << ":" << o.script.port << ": "
+              << s.connect_error << "\n";
+    return 1;
+  }
+  if (o.json) {
+    nlohmann::json j = {{"clients", s.clients},
+                        {"welcomed", s.welcomed},
+                        {"snapshots", s.snapshots},
+                        {"snapshot_rate_hz", s.snapshot_rate_hz},
+                        {"bytes_per_s", s.bytes_per_s},
+                        {"rtt_ms", s.rtt_ms},
+                        {"balls", s.balls},
+                        {"errors", s.error_messages.size()},
+                        {"error_messages", s.error_messages}};
+    std::cout << j.dump() << std::endl;
+  } else {
+    std::cout << s.welcomed << " of " << s.clients << " clients welcomed; " << s.snapshots << " snapshots ("
+              << s.snapshot_rate_hz << " Hz and " << s.bytes_per_s / 1e3 << " kB/s per client); rtt " << s.rtt_ms
+              << " ms; " << s.balls << " balls\n";
+    for (const std::string& e : s.error_messages) std::cout << "error: " << e << "\n";
+  }
+  return 0;
+}

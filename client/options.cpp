@@ -1,0 +1,99 @@
+#include "client/options.h"
+
+#include <boost/program_options.hpp>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "protocol/frame_codec.h"
+
+namespace fishtank::client {
+
+namespace po = boost::program_options;
+
+namespace {
+
+// "x,y,z" with three finite numbers and nothing else.
+std::optional<Vec3> parse_vec3(const std::string& text) {
+  Vec3 v;
+  int consumed = 0;
+  if (std::sscanf(text.c_str(), "%f,%f,%f%n", &v.x, &v.y, &v.z, &consumed) != 3) return std::nullopt;
+  if (static_cast<std::size_t>(consumed) != text.size() || !is_finite(v)) return std::nullopt;
+  return v;
+}
+
+// "host:port"
+bool split_host_port(const std::string& text, std::string& host, std::uint16_t& port) {
+  const std::size_t colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0) return false;
+  const std::string port_text = text.substr(colon + 1);
+  if (port_text.empty() || port_text.size() > 5 || port_text.find_first_not_of("0123456789") != std::string::npos)
+    return false;
+  const long value = std::stol(port_text);
+  if (value < 1 || value > 65535) return false;
+  host = text.substr(0, colon);
+  port = static_cast<std::uint16_t>(value);
+  return true;
+}
+
+}  // namespace
+
+ClientParse parse_client_options(int argc, const char* const argv[]) {
+  ClientOptions o;
+  std::string connect = "127.0.0.1:7878", move;
+  std::int64_t clients = 1, add = 0;
+
+  po::options_description flags("Options");
+  flags.add_options()("help,h", "print this help and exit")("connect", po::value(&connect)->default_value(connect),
+                                                            "server address, host:port")(
+      "clients", po::value(&clients)->default_value(clients), "concurrent connections, 1 .. 1000")(
+      "observer", po::bool_switch(&o.script.observer), "ask for no player sphere")(
+      "add", po::value(&add)->default_value(0), "balls the first client asks the server to pour in")(
+      "move", po::value(&move), "player sphere velocity x,y,z in m/s (every client with a sphere)")(
+      "for", po::value(&o.script.move_for)->default_value(o.script.move_for), "seconds to move before stopping")(
+      "duration", po::value(&o.script.duration)->default_value(o.script.duration), "seconds to stay connected")(
+      "json", po::bool_switch(&o.json), "print one JSON summary on stdout");
+
+  ClientParse result;
+  auto fail = [&result](const std::string& why) {
+    result.exit_code = 2;
+    result.message = "fishtank-client: " + why + "\nTry --help for the list of options.";
+    return result;
+  };
+  po::variables_map vm;
+  try {
+    po::store(po::parse_command_line(argc, argv, flags), vm);
+    po::notify(vm);
+  } catch (const po::error& e) {
+    return fail(e.what());
+  }
+  if (vm.count("help")) {
+    std::ostringstream help;
+    help << "fishtank-client: connects to a fishtank-server, runs a short script and reports what it received.\n\n"
+         << "Usage: fishtank-client [--connect host:port] [--clients K] [--observer] [--add N]\n"
+         << "                       [--move x,y,z --for T] [--duration T] [--json]\n\n"
+         << "Example: fishtank-client --clients 8 --add 1000 --move 2,0,0 --for 1 --duration 5 --json\n\n"
+         << flags;
+    result.message = help.str();
+    return result;
+  }
+  if (!split_host_port(connect, o.script.host, o.script.port))
+    return fail("--connect wants host:port with a port 1 .. 65535, got '" + connect + "'");
+  if (clients < 1 || clients > 1000) return fail("--clients must be between 1 and 1000");
+  if (add < 0 || add > protocol::kMaxAddBallsPerRequest)
+    return fail("--add must be between 0 and " + std::to_string(protocol::kMaxAddBallsPerRequest));
+  if (!vm["move"].empty()) {
+    o.script.move = parse_vec3(move);
+    if (!o.script.move) return fail("--move wants three finite numbers x,y,z, got '" + move + "'");
+    if (o.script.observer) return fail("--move needs a player sphere; drop --observer");
+  }
+  if (!std::isfinite(o.script.move_for) || o.script.move_for < 0.0) return fail("--for must be seconds >= 0");
+  if (!std::isfinite(o.script.duration) || o.script.duration <= 0.0 || o.script.duration > 86400.0)
+    return fail("--duration must be between 0 and 86400 seconds");
+  o.script.clients = static_cast<int>(clients);
+  o.script.add = static_cast<std::uint32_t>(add);
+  result.options = o;
+  return result;
+}
+
+}  // namespace fishtank::client

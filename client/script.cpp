@@ -1,0 +1,118 @@
+#include "client/script.h"
+
+#include <algorithm>
+#include <boost/asio.hpp>
+#include <chrono>
+#include <functional>
+#include <memory>
+
+#include "client/connection.h"
+
+namespace fishtank::client {
+
+namespace asio = boost::asio;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+constexpr auto kTick = std::chrono::milliseconds(50);
+constexpr int kTicksPerPing = 5;
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+Summary summarise(const std::vector<std::shared_ptr<Connection>>& connections, double seconds) {
+  Summary s;
+  s.clients = static_cast<int>(connections.size());
+  std::vector<double> rtts;
+  std::uint32_t newest_tick = 0;
+  for (const auto& c : connections) {
+    const ConnectionStats& st = c->stats();
+    s.welcomed += c->welcomed();
+    s.snapshots += st.snapshots;
+    s.bytes_per_s += st.bytes_received / seconds;
+    if (st.snapshots >= 2)
+      s.snapshot_rate_hz +=
+          (st.snapshots - 1) / std::chrono::duration<double>(*st.last_snapshot - *st.first_snapshot).count();
+    rtts.insert(rtts.end(), st.rtt_ms.begin(), st.rtt_ms.end());
+    s.error_messages.insert(s.error_messages.end(), st.errors.begin(), st.errors.end());
+    if (st.snapshots > 0 && c->view().tick >= newest_tick) {
+      newest_tick = c->view().tick;
+      s.balls = c->view().ball_count;
+    }
+    if (!c->welcomed() && !c->close_reason().empty()) s.error_messages.push_back("connection: " + c->close_reason());
+  }
+  if (s.clients > 0) {
+    s.snapshot_rate_hz /= s.clients;
+    s.bytes_per_s /= s.clients;
+  }
+  if (!rtts.empty()) {
+    std::nth_element(rtts.begin(), rtts.begin() + rtts.size() / 2, rtts.end());
+    s.rtt_ms = rtts[rtts.size() / 2];
+  }
+  return s;
+}
+
+}  // namespace
+
+Summary run_script(const Script& script) {
+  asio::io_context io;
+  boost::system::error_code ec;
+  asio::ip::tcp::resolver resolver(io);
+  const auto resolved = resolver.resolve(script.host, std::to_string(script.port), ec);
+  if (ec || resolved.empty()) {
+    Summary failed;
+    failed.connect_error = "cannot resolve " + script.host + ": " + ec.message();
+    return failed;
+  }
+  const asio::ip::tcp::endpoint server = *resolved.begin();
+
+  std::vector<std::shared_ptr<Connection>> connections;
+  for (int i = 0; i < script.clients; ++i) {
+    connections.push_back(
+        std::make_shared<Connection>(io, "fishtank-client-" + std::to_string(i + 1), !script.observer));
+    connections.back()->start(server);
+  }
+
+  const Clock::time_point start = Clock::now();
+  bool added = false;
+  // Per connection: 0 not moving yet, 1 moving, 2 stopped after --for seconds.
+  std::vector<int> move_phase(connections.size(), 0);
+  int tick = 0;
+  asio::steady_timer timer(io);
+  std::function<void()> on_tick = [&] {
+    const double t = seconds_since(start);
+    if (t >= script.duration) {
+      for (auto& c : connections) c->close();
+      return;
+    }
+    if (!added && script.add > 0 && connections.front()->welcomed()) {
+      connections.front()->send(protocol::encode_add_balls(script.add));
+      added = true;
+    }
+    for (std::size_t i = 0; script.move && i < connections.size(); ++i) {
+      if (!connections[i]->player_id()) continue;
+      if (move_phase[i] == 0) {
+        connections[i]->send(protocol::encode_player_input(1, *script.move));
+        move_phase[i] = 1;
+      } else if (move_phase[i] == 1 && t >= script.move_for) {
+        connections[i]->send(protocol::encode_player_input(2, {0.0f, 0.0f, 0.0f}));
+        move_phase[i] = 2;
+      }
+    }
+    if (tick++ % kTicksPerPing == 0)
+      for (auto& c : connections)
+        if (c->welcomed()) c->send_ping();
+    timer.expires_after(kTick);
+    timer.async_wait([&](boost::system::error_code e) {
+      if (!e) on_tick();
+    });
+  };
+  on_tick();
+  io.run();
+
+  Summary summary = summarise(connections, std::max(script.duration, 1e-3));
+  if (summary.welcomed == 0 && !connections.empty()) summary.connect_error = connections.front()->close_reason();
+  return summary;
+}
+
+}  // namespace fishtank::client

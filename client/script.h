@@ -1,0 +1,41 @@
+#pragma once
+// A scripted session against a server: K connections on one thread, each says
+// Hello; the first asks for --add balls; those with a player sphere move it at
+// --move for --for seconds; every connection pings four times a second; after
+// --duration seconds everything is summed up.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/vec3.h"
+
+namespace fishtank::client {
+
+struct Script {
+  std::string host = "127.0.0.1";
+  std::uint16_t port = 7878;
+  int clients = 1;
+  bool observer = false;
+  std::uint32_t add = 0;
+  std::optional<Vec3> move;
+  double move_for = 1.0;  // seconds
+  double duration = 3.0;  // seconds
+};
+
+struct Summary {
+  int clients = 0;
+  int welcomed = 0;
+  std::uint64_t snapshots = 0;    // total over all clients
+  double snapshot_rate_hz = 0.0;  // mean per client
+  double bytes_per_s = 0.0;       // mean per client
+  double rtt_ms = 0.0;            // median over every Pong; 0 without any
+  std::uint32_t balls = 0;        // newest ball count seen
+  std::vector<std::string> error_messages;
+  std::string connect_error;  // non-empty when no connection could be made
+};
+
+Summary run_script(const Script& script);
+
+}  // namespace fishtank::client
