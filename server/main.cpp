@@ -12,6 +12,7 @@
 #include "server/bench/benchmark.h"
 #include "server/bench/scenes.h"
 #include "server/export/csv_dump.h"
+#include "server/export/lammps_export.h"
 #include "server/net/network_service.h"
 #include "server/options.h"
 #include "server/realtime_loop.h"
@@ -31,13 +32,14 @@ const fishtank::Kernels& kKernels = fishtank::kScalarKernels;
 // Set by SIGINT/SIGTERM (the network service's signal_set) to end the realtime loop.
 std::atomic<bool> g_stop{false};
 
-int write_dump_if_asked(const fishtank::World& world, const fishtank::ServerOptions& o) {
-  if (o.dump_path.empty()) return 0;
-  if (std::string err = fishtank::write_csv_dump(world, o.dump_path); !err.empty()) {
-    std::cerr << "fishtank-server: " << err << "\n";
-    return 1;
-  }
-  return 0;
+// The final-state files asked for on the command line.
+int write_final_state(const fishtank::World& world, const fishtank::ServerOptions& o) {
+  std::string err;
+  if (!o.dump_path.empty()) err = fishtank::write_csv_dump(world, o.dump_path);
+  if (err.empty() && !o.lammps_dir.empty()) err = fishtank::export_lammps(world, o.lammps_dir, o.lammps_steps);
+  if (err.empty()) return 0;
+  std::cerr << "fishtank-server: " << err << "\n";
+  return 1;
 }
 
 int run_bench(const fishtank::ServerOptions& o) {
@@ -53,7 +55,7 @@ int run_bench(const fishtank::ServerOptions& o) {
   std::cerr << "timing " << o.bench_spec.steps << " steps of " << world.ball_count() << " balls\n";
   nlohmann::json report = fishtank::time_steps(world, o.bench_spec, settled);
   std::cout << report.dump(2) << std::endl;
-  return write_dump_if_asked(world, o);
+  return write_final_state(world, o);
 }
 
 fishtank::net::NetOptions net_options(const fishtank::ServerOptions& o) {
@@ -92,11 +94,22 @@ int run_server(const fishtank::ServerOptions& o) {
     std::cerr << "fishtank-server: " << error << "\n";
     return 1;
   }
+  fishtank::LammpsDumpWriter recorder;
+  if (!o.record_path.empty()) {
+    if (std::string error = recorder.open(o.record_path); !error.empty()) {
+      std::cerr << "fishtank-server: " << error << "\n";
+      return 1;
+    }
+  }
+  std::uint64_t next_frame = 0;  // step at which the next trajectory frame is due
   fishtank::LoopOptions loop;
   loop.duration = o.duration;
   loop.status_interval = o.status_interval;
-  loop.at_step_boundary = [&network](fishtank::World& w, const fishtank::LoopStatus& s) {
+  loop.at_step_boundary = [&](fishtank::World& w, const fishtank::LoopStatus& s) {
     network.at_step_boundary(w, s);
+    if (o.record_path.empty() || w.steps() < next_frame) return;
+    if (std::string error = recorder.write_frame(w); !error.empty()) spdlog::error("{}", error);
+    next_frame = w.steps() + o.record_every;
   };
   loop.on_status = [&network](const fishtank::World& w, const fishtank::LoopStatus& s) {
     std::fprintf(stderr, "t = %7.1f s  balls %5u (+%u queued)  %6.0f steps/s  load %5.1f %%  %s%s\n", w.time(),
@@ -105,7 +118,7 @@ int run_server(const fishtank::ServerOptions& o) {
   };
   fishtank::run_realtime(world, loop, g_stop);
   std::cerr << "fishtank-server: stopped after " << world.steps() << " steps, " << world.ball_count() << " balls\n";
-  return write_dump_if_asked(world, o);
+  return write_final_state(world, o);
 }
 
 }  // namespace

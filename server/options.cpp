@@ -29,8 +29,17 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "balls to pour in at start (default 1000; with --bench, 6000)")(
       "max-balls", po::value(&max_balls)->default_value(0), "most balls the tank may hold (0: its capacity, ~6100)")(
       "duration", po::value(&o.duration)->default_value(0.0), "stop after this many seconds (0: run until Ctrl-C)")(
-      "status-interval", po::value(&o.status_interval)->default_value(1.0), "seconds between status lines")(
-      "dump", po::value(&o.dump_path), "write the final state as CSV (x,y,z,vx,vy,vz,diameter,mass)");
+      "status-interval", po::value(&o.status_interval)->default_value(1.0), "seconds between status lines");
+
+  std::int64_t lammps_steps = static_cast<std::int64_t>(o.lammps_steps), record_every = o.record_every;
+  po::options_description output("Output (written when the server stops, or after --bench)");
+  output.add_options()("dump", po::value(&o.dump_path), "final state as CSV (x,y,z,vx,vy,vz,diameter,mass)")(
+      "export-lammps", po::value(&o.lammps_dir),
+      "write DIR/data.fishtank and DIR/in.fishtank: the final state and contact model for LAMMPS")(
+      "lammps-steps", po::value(&lammps_steps)->default_value(lammps_steps), "steps the exported LAMMPS script runs")(
+      "record", po::value(&o.record_path),
+      "trajectory in LAMMPS dump format (OVITO, ASE, LAMMPS), while the server runs")(
+      "record-every", po::value(&record_every)->default_value(record_every), "steps between recorded frames");
 
   std::int64_t port = o.port, max_players = o.max_players;
   po::options_description network("Network");
@@ -42,14 +51,14 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "player spheres at most; later clients observe");
 
   po::options_description physics("Physics");
-  physics.add_options()("stiffness", po::value(&o.physics.stiffness)->default_value(defaults.stiffness),
+  physics.add_options()("stiffness", po::value(&o.physics.stiffness)->default_value(defaults.stiffness, "20000"),
                         "contact spring constant k, N/m")(
-      "restitution", po::value(&o.physics.restitution)->default_value(defaults.restitution),
+      "restitution", po::value(&o.physics.restitution)->default_value(defaults.restitution, "0.6"),
       "coefficient of restitution e, (0, 1]")(
       "steps-per-contact", po::value(&steps_per_contact)->default_value(steps_per_contact),
       "automatic dt = contact duration / this (>= 10)")(
       "dt", po::value(&o.physics.dt)->default_value(0.0), "fixed time step in seconds (0: automatic)")(
-      "skin", po::value(&o.physics.skin)->default_value(defaults.skin), "neighbour-list skin, units");
+      "skin", po::value(&o.physics.skin)->default_value(defaults.skin, "0.3"), "neighbour-list skin, units");
 
   po::options_description bench("Benchmark");
   bench.add_options()("bench", po::bool_switch(&o.bench), "run unpaced without network and print one JSON object")(
@@ -59,7 +68,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "most simulated seconds to wait for rest (0: 90 for tank, 4 for wide)");
 
   po::options_description all;
-  all.add(general).add(network).add(physics).add(bench);
+  all.add(general).add(network).add(physics).add(bench).add(output);
 
   ParseResult result;
   std::ostringstream help;
@@ -92,6 +101,14 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   if (!threaded && threads != 1) return fail("the scalar build runs on one thread; drop --threads or use fishtank-server");
   if (seed < 0) return fail("--seed must be >= 0");
   if (steps < 1 || steps > 1'000'000'000) return fail("--steps must be between 1 and 1e9, got " + std::to_string(steps));
+  if (lammps_steps < 0 || lammps_steps > 1'000'000'000'000)
+    return fail("--lammps-steps must be between 0 and 1e12, got " + std::to_string(lammps_steps));
+  if (record_every < 1 || record_every > 1'000'000'000)
+    return fail("--record-every must be between 1 and 1e9 steps, got " + std::to_string(record_every));
+  if (o.bench && !o.record_path.empty())
+    return fail("--record records a running server; with --bench use --dump or --export-lammps for the final state");
+  o.lammps_steps = static_cast<std::uint64_t>(lammps_steps);
+  o.record_every = static_cast<std::uint32_t>(record_every);
   if (max_balls < 0 || max_balls > 10'000'000) return fail("--max-balls must be between 0 and 10000000");
   if (!std::isfinite(o.duration) || o.duration < 0.0) return fail("--duration must be a number of seconds >= 0");
   if (!std::isfinite(o.status_interval) || o.status_interval < 0.05 || o.status_interval > 3600.0)

@@ -19,6 +19,10 @@ struct ServerOptions {
   double duration = 0.0;        // seconds of real time; 0: until interrupted
   double status_interval = 1.0;
   std::string dump_path;
+  std::string lammps_dir;              // --export-lammps
+  std::uint64_t lammps_steps = 10000;  // steps the exported script runs
+  std::string record_path;             // LAMMPS dump trajectory
+  std::uint32_t record_every = 100;    // steps between frames
   PhysicsParams physics;
   // Network (not used by --bench, which never opens a socket).
   std::string bind = "127.0.0.1";

@@ -9,8 +9,13 @@
 namespace fishtank {
 
 namespace {
-// About 20-50 microseconds of polling before a worker goes to sleep.
-constexpr int kSpinIterations = 20000;
+// About 50-300 microseconds of polling (pause lasts 10-140 cycles depending
+// on the core) before a worker sleeps: long enough to bridge the serial gaps
+// between passes of back-to-back steps, short enough that a paced server's
+// idle workers do not hold a core between batches.
+constexpr int kSpinIterations = 2000;
+// Fewer items than this per thread cost more to hand out than to compute.
+constexpr std::uint32_t kMinItemsPerThread = 1024;
 }  // namespace
 
 int WorkerPool::hardware_threads() { return std::max(1u, boost::thread::hardware_concurrency()); }
@@ -30,19 +35,22 @@ WorkerPool::~WorkerPool() {
 }
 
 void WorkerPool::run_chunk(int thread) {
+  if (thread >= active_) return;
   std::uint64_t n = count_;
-  auto begin = static_cast<std::uint32_t>(n * thread / thread_count_);
-  auto end = static_cast<std::uint32_t>(n * (thread + 1) / thread_count_);
+  auto begin = static_cast<std::uint32_t>(n * thread / active_);
+  auto end = static_cast<std::uint32_t>(n * (thread + 1) / active_);
   if (begin < end) (*phase_)(begin, end, thread);
 }
 
 void WorkerPool::run(std::uint32_t count, const Phase& phase) {
-  if (thread_count_ == 1) {
+  const int useful = static_cast<int>(std::min<std::uint32_t>(count / kMinItemsPerThread, thread_count_));
+  if (useful <= 1) {
     if (count > 0) phase(0, count, 0);
     return;
   }
   phase_ = &phase;
   count_ = count;
+  active_ = useful;
   pending_.store(thread_count_ - 1, std::memory_order_relaxed);
   {
     // Taking the lock orders the publish against a worker that is about to sleep.

@@ -10,7 +10,9 @@
 // phase lasts tens of microseconds in benchmark mode, so workers spin briefly
 // before sleeping on a condition variable: a wake-up from spinning costs well
 // under a microsecond, one from sleep several. With one thread, run() is a
-// plain call with no synchronisation at all.
+// plain call with no synchronisation at all, and so is a phase too small to
+// be worth splitting (under ~1000 items per thread). Results never depend on
+// the split: each item is computed by exactly one thread, the same way.
 
 #include <atomic>
 #include <boost/thread/condition_variable.hpp>
@@ -46,6 +48,7 @@ class WorkerPool {
   std::vector<boost::thread> workers_;
   const Phase* phase_ = nullptr;
   std::uint32_t count_ = 0;
+  int active_ = 1;  // threads given a chunk in the current phase
   std::atomic<std::uint64_t> generation_{0};
   std::atomic<int> pending_{0};
   std::atomic<bool> stopping_{false};

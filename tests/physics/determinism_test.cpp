@@ -12,15 +12,23 @@ using namespace fishtank;
 namespace {
 
 std::uint64_t run(int threads) {
-  World world(PhysicsParams{}, kSseKernels, threads, 99);
-  world.add_balls(1200);
+  // 5000 balls, so that even 4 threads each get a chunk worth splitting off.
+  PhysicsParams params;
+  params.tank.min = {-40.0f, 0.0f, -40.0f};
+  params.tank.max = {40.0f, 40.0f, 40.0f};
+  World world(params, kSseKernels, threads, 99);
+  for (int b = 0; b < 5000; ++b) {
+    Vec3 p{-39.0f + 3.05f * (b % 26), 1.6f + 3.05f * (b / 676), -39.0f + 3.05f * ((b / 26) % 26)};
+    world.place_ball(b % kKindCount, p, Vec3{0.1f * (b % 7) - 0.3f, 0.0f, 0.1f * (b % 5) - 0.2f});
+  }
   const std::uint32_t player = world.add_player();
   world.set_player_velocity(player, {3.0f, -4.0f, 1.0f});
-  for (int s = 0; s < 4000; ++s) {
-    if (s == 2000) world.set_player_velocity(player, {-6.0f, 2.0f, 0.0f});
+  for (int s = 0; s < 1500; ++s) {
+    if (s == 750) world.set_player_velocity(player, {-6.0f, 2.0f, 0.0f});
     world.step();
   }
   REQUIRE(world.threads() == threads);
+  REQUIRE(world.escaped_or_invalid() == 0);
   return world.state_hash();
 }
 
