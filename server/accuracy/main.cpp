@@ -1,0 +1,153 @@
+// fishtank-accuracy: the measurements of SPEC 7.1 and 7.2 (docs/accuracy.md).
+//
+//   fishtank-accuracy [--out DIR] [--quick] [--scalar]
+//
+// Writes to DIR (default .):
+//   accuracy.csv          scene, method, n, dt, error, CPU seconds per run
+//   accuracy-orders.csv   observed order of each scene and method, vs dt and vs CPU time
+//   stability.csv         the (k, dt) map with its measurements and class
+//   stability-product.csv the server's automatic dt at the default k, classified
+// and prints a summary. --quick runs a coarse sweep (seconds); --scalar uses
+// the scalar kernels instead of the SSE ones the server ships.
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "server/accuracy/reference.h"
+#include "server/accuracy/stability.h"
+#include "server/accuracy/sweep.h"
+#include "server/physics/params.h"
+
+using namespace fishtank;
+using namespace fishtank::accuracy;
+
+namespace {
+
+constexpr int kFitMinSteps = 10, kFitMaxSteps = 80;
+
+struct Options {
+  std::string out = ".";
+  bool quick = false;
+  const Kernels* kernels = &kSseKernels;
+};
+
+bool parse(int argc, char** argv, Options& o) {
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--out") && i + 1 < argc)
+      o.out = argv[++i];
+    else if (!std::strcmp(argv[i], "--quick"))
+      o.quick = true;
+    else if (!std::strcmp(argv[i], "--scalar"))
+      o.kernels = &kScalarKernels;
+    else
+      return false;
+  }
+  return true;
+}
+
+std::ofstream open_csv(const Options& o, const char* name, const char* header) {
+  std::ofstream f(o.out + "/" + name);
+  if (!f) throw std::runtime_error(std::string("cannot write ") + o.out + "/" + name);
+  f.precision(6);
+  f << header << '\n';
+  return f;
+}
+
+// The half-decade grid of the map: 10^(lo/2) ... 10^(hi/2).
+std::vector<double> half_decades(int lo, int hi, int stride) {
+  std::vector<double> v;
+  for (int i = lo; i <= hi; i += stride) v.push_back(std::pow(10.0, i / 2.0));
+  return v;
+}
+
+void report_drop(const SceneConfig& config) {
+  const double t_c = contact_duration(static_cast<float>(config.k));
+  const LinearContact contact{1.0, config.k, pair_damping(config.k, config.restitution, 1.0)};
+  const auto exact = exact_apexes(contact, 9.81, kDropHeight, kDropBounces);
+  const auto ideal = instantaneous_apexes(config.restitution, kDropHeight, kDropBounces);
+  const auto world = measured_apexes(methods().front(), config, t_c / 20);
+  std::printf("\ndrop from %.1f: apex heights (exact model | e^2n h0 | World at t_c/20)\n", kDropHeight);
+  for (int n = 0; n < kDropBounces; ++n)
+    std::printf("  bounce %d: %.6f | %.6f (%+.2f%%) | %.6f (%+.3f%%)\n", n + 1, exact[n], ideal[n],
+                100 * (ideal[n] / exact[n] - 1), world[n], 100 * (world[n] / exact[n] - 1));
+}
+
+void run_accuracy(const Options& o, const SceneConfig& config) {
+  const std::vector<int> n_values =
+      o.quick ? std::vector<int>{10, 20, 40, 80} : std::vector<int>{5, 10, 20, 40, 80, 160, 320, 640};
+  const auto points = run_sweep(config, n_values, o.quick ? 0.0 : 0.02);
+  std::ofstream csv = open_csv(o, "accuracy.csv", "scene,method,steps_per_contact,dt,error,cpu_seconds");
+  for (const SweepPoint& p : points)
+    csv << p.scene << ',' << p.method << ',' << p.steps_per_contact << ',' << p.dt << ',' << p.error << ','
+        << p.cpu_seconds << '\n';
+
+  // Fitted over n = 10 ... 80: below 10 the errors are not yet asymptotic, above
+  // 80 World's float32 state sets a floor near 1e-5 on the smooth scenes.
+  const auto orders = fit_orders(points, kFitMinSteps, kFitMaxSteps);
+  std::ofstream ocsv = open_csv(o, "accuracy-orders.csv", "scene,method,order_dt,order_cpu,error_at_product_dt");
+  std::printf("%-16s %-17s %8s %8s %14s\n", "scene", "method", "p(dt)", "q(cpu)", "error@t_c/20");
+  for (const Order& ord : orders) {
+    double at_product = NAN;
+    for (const SweepPoint& p : points)
+      if (p.scene == ord.scene && p.method == ord.method && p.steps_per_contact == 20) at_product = p.error;
+    ocsv << ord.scene << ',' << ord.method << ',' << ord.vs_dt << ',' << ord.vs_cpu << ',' << at_product << '\n';
+    std::printf("%-16s %-17s %8.2f %8.2f %14.3e\n", ord.scene.c_str(), ord.method.c_str(), ord.vs_dt, ord.vs_cpu,
+                at_product);
+  }
+  report_drop(config);
+}
+
+void run_stability(const Options& o) {
+  const auto ks = o.quick ? half_decades(4, 14, 2) : half_decades(4, 14, 1);       // 1e2 ... 1e7 N/m
+  const auto dts = o.quick ? half_decades(-10, -2, 2) : half_decades(-12, -2, 1);  // 1e-6 ... 1e-1 s
+  std::ofstream csv = open_csv(o, "stability.csv", "k,dt,dt_over_tc,restitution,overlap,energy_ratio,class,class_name");
+  auto write = [](std::ofstream& f, const StabilityCell& c) {
+    f << c.k << ',' << c.dt << ',' << c.dt / contact_duration(static_cast<float>(c.k)) << ',' << c.restitution << ','
+      << c.overlap << ',' << c.energy_ratio << ',' << int(c.stability) << ',' << stability_name(c.stability) << '\n';
+  };
+  std::printf("\nstability: largest dt / t_c of each class boundary, per k\n");
+  for (double k : ks) {
+    const double t_c = contact_duration(static_cast<float>(k));
+    double last_accurate = 0, last_stable = 0;
+    for (double dt : dts) {
+      const StabilityCell c = classify(k, dt, *o.kernels);
+      write(csv, c);
+      if (c.stability == Stability::kAccurate) last_accurate = dt;
+      if (c.stability != Stability::kUnstable) last_stable = dt;
+    }
+    csv << '\n';  // gnuplot's pm3d reads one scan per k
+    std::printf("  k = %8.3g: accurate up to dt/t_c = %.3g, stable up to %.3g (theory: 2/pi = 0.637)\n", k,
+                last_accurate / t_c, last_stable / t_c);
+  }
+
+  const PhysicsParams product;
+  const StabilityCell c = classify(product.stiffness, derived_dt(product), *o.kernels);
+  std::ofstream pcsv =
+      open_csv(o, "stability-product.csv", "k,dt,dt_over_tc,restitution,overlap,energy_ratio,class,class_name");
+  write(pcsv, c);
+  std::printf("  product: k = %g, dt = %.4g s -> %s (e = %.4f, overlap %.3f, energy ratio %.3f)\n", c.k, c.dt,
+              stability_name(c.stability), c.restitution, c.overlap, c.energy_ratio);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  if (!parse(argc, argv, o)) {
+    std::fprintf(stderr, "usage: fishtank-accuracy [--out DIR] [--quick] [--scalar]\n");
+    return 2;
+  }
+  try {
+    run_accuracy(o, SceneConfig{2.0e4, 0.6, o.kernels});
+    run_stability(o);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fishtank-accuracy: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

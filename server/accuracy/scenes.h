@@ -1,0 +1,59 @@
+#pragma once
+// Scenes with known answers (SPEC 7.1), each run by the product's World or by
+// one of the 1-D schemes of contact_1d.h at a given dt, returning one error:
+//
+//   drop             ball (d = 1) dropped from 1 unit onto the floor: worst error of
+//                    the first three apex heights against exact_apexes, / h0
+//   head-on          two balls meeting at 2 m/s, no gravity, every size pair: worst
+//                    error of the rebound velocities against exact_rebound, / 2 m/s
+//   head-on-elastic  the same with e = 1 (no dashpot)
+//   energy           ball (d = 1) resting on the floor, e = 1, released 0.9 of its
+//                    static overlap above equilibrium: worst energy error over five
+//                    periods, / the oscillation energy
+//
+// An error is NaN when the run never produced the measured event (a contact
+// that never ends, a bounce that never comes).
+
+#include <vector>
+
+#include "server/accuracy/contact_1d.h"
+#include "server/physics/kernels.h"
+
+namespace fishtank::accuracy {
+
+struct Method {
+  const char* name;
+  bool world;     // the product's World (float, full kernels) ...
+  Scheme scheme;  // ... or this scheme on the 1-D problem (double)
+};
+
+// World first: it is what the product runs.
+const std::vector<Method>& methods();
+
+struct SceneConfig {
+  double k = 2.0e4;          // product default
+  double restitution = 0.6;  // product default
+  const Kernels* kernels = &kSseKernels;
+};
+
+struct Scene {
+  const char* name;
+  double (*error)(const Method& method, const SceneConfig& config, double dt);
+};
+
+const std::vector<Scene>& scenes();
+
+// One size pair of the head-on scene (kinds index kBallKinds): each ball at
+// kHeadOnSpeed, kHeadOnGap apart. The measured restitution is the rebound over
+// the approach speed (NaN if the contact never ends).
+inline constexpr double kHeadOnSpeed = 1.0;
+inline constexpr double kHeadOnGap = 0.05;
+double measured_restitution(const Method& method, const SceneConfig& config, double dt, int kind_a, int kind_b);
+double head_on_pair_error(const Method& method, const SceneConfig& config, double dt, int kind_a, int kind_b);
+
+// The drop scene's constants and the apexes a run measures.
+inline constexpr double kDropHeight = 1.0;
+inline constexpr int kDropBounces = 3;
+std::vector<double> measured_apexes(const Method& method, const SceneConfig& config, double dt);
+
+}  // namespace fishtank::accuracy
