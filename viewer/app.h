@@ -17,7 +17,7 @@ struct ViewerOptions {
   bool observer = false;  // no player sphere of our own
   bool hud = true;
   bool tank_outline = false;  // start with the tank's edges shown
-  std::string screenshot;  // non-empty: save this PNG after `frames` frames, then exit
+  std::string screenshot;     // non-empty: save this PNG after `frames` frames, then exit
   int frames = 1;
   double screenshot_timeout = 30.0;  // seconds to wait for the first snapshot
 };

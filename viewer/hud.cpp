@@ -124,8 +124,8 @@ void Hud::connection(const HudView& v) {
     ImGui::TextColored(kWarn, "No connection to the server at %s", net.endpoint.c_str());
     ImGui::SetWindowFontScale(1.0f);
     ImGui::Text("%s", net.last_error.c_str());
-    ImGui::Text("Retrying every second (attempt %d). Start one with: build/server/fishtank-server",
-                net.attempt);
+    ImGui::Text("Retrying every second (%d attempt%s so far).", net.attempts, net.attempts == 1 ? "" : "s");
+    ImGui::Text("To start a server here: build/server/fishtank-server");
   }
   ImGui::End();
 }

@@ -62,7 +62,10 @@ ConnectionStatus NetClient::status() const {
 }
 
 void NetClient::do_connect() {
-  update_status([](ConnectionStatus& s) { s.state = ConnectionStatus::State::connecting; });
+  update_status([](ConnectionStatus& s) {
+    s.state = ConnectionStatus::State::connecting;
+    ++s.attempts;
+  });
   const std::uint64_t gen = generation_;
   resolver_.async_resolve(
       host_, port_, [this, gen](error_code ec, const tcp::resolver::results_type& results) {
@@ -85,7 +88,6 @@ void NetClient::lose(const std::string& why) {
   write_queue_.clear();
   connected_ = false;
   update_status([&](ConnectionStatus& s) {
-    if (s.state == ConnectionStatus::State::lost) ++s.attempt;
     s.state = ConnectionStatus::State::lost;
     s.last_error = why;
     s.rtt_ms = -1.0f;
@@ -203,7 +205,7 @@ void NetClient::on_welcome(const wire::Welcome& w) {
   snapshots_.clear();
   update_status([&](ConnectionStatus& s) {
     s.state = ConnectionStatus::State::connected;
-    s.attempt = 1;
+    s.attempts = 0;
     s.last_error.clear();
     s.info = info;
   });

@@ -31,7 +31,7 @@ struct ConnectionStatus {
   State state = State::connecting;
   std::string endpoint;                    // host:port, for messages
   std::string last_error;                  // why the last connection ended or failed
-  int attempt = 1;                         // connection attempts since the last success
+  int attempts = 0;                        // connection attempts since the last Welcome
   std::shared_ptr<const ServerInfo> info;  // from Welcome; null before it
   float snapshots_per_s = 0.0f;            // each measured over the last second
   float bytes_per_s = 0.0f;
