@@ -18,12 +18,14 @@
 #include "server/realtime_loop.h"
 
 #ifndef FISHTANK_SIMD
-#error "FISHTANK_SIMD must be defined (0: scalar twin, 1: SSE)"
+#error "FISHTANK_SIMD must be defined (0: scalar twin, 1: SSE, 2: AVX2)"
 #endif
 
 namespace {
 
-#if FISHTANK_SIMD
+#if FISHTANK_SIMD == 2
+const fishtank::Kernels& kKernels = fishtank::kAvx2Kernels;
+#elif FISHTANK_SIMD == 1
 const fishtank::Kernels& kKernels = fishtank::kSseKernels;
 #else
 const fishtank::Kernels& kKernels = fishtank::kScalarKernels;
@@ -124,6 +126,10 @@ int run_server(const fishtank::ServerOptions& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (FISHTANK_SIMD == 2 && !fishtank::cpu_has_avx2()) {
+    std::cerr << "fishtank-server-avx2: this processor has no AVX2; use fishtank-server (SSE4.1) instead\n";
+    return 1;
+  }
   fishtank::ParseResult parsed =
       fishtank::parse_server_options(argc, argv, kKernels.variant, kKernels.threaded);
   if (!parsed.options) {

@@ -45,6 +45,7 @@ inline F4 max(F4 a, F4 b) { return {_mm_max_ps(a.v, b.v)}; }
 inline F4 min(F4 a, F4 b) { return {_mm_min_ps(a.v, b.v)}; }
 inline M4 operator<(F4 a, F4 b) { return {_mm_cmplt_ps(a.v, b.v)}; }
 inline M4 operator>(F4 a, F4 b) { return {_mm_cmpgt_ps(a.v, b.v)}; }
+inline M4 operator|(M4 a, M4 b) { return {_mm_or_ps(a.v, b.v)}; }
 inline bool any(M4 m) { return _mm_movemask_ps(m.v) != 0; }
 // Lanes where the mask is off become zero.
 inline F4 keep(M4 m, F4 a) { return {_mm_and_ps(m.v, a.v)}; }

@@ -2,8 +2,9 @@
 // The two hot passes of a step, each in two twins with the same signature:
 //   kernels_scalar.cpp  plain C++, one pair at a time (the reference)
 //   kernels_sse.cpp     SSE4.1, four neighbours at a time
+// kernels_sse.cpp compiled again with -mavx2 is a third level (kAvx2Kernels).
 // A build picks one set at compile time (see server/main.cpp); the tests hold
-// both so they can compare them.
+// them all so they can compare them.
 //
 // Velocity Verlet, split so each pass writes only ball i and reads neighbours
 // only from arrays the pass does not write (no races, no atomics):
@@ -45,6 +46,9 @@ struct Kernels {
 
 extern const Kernels kScalarKernels;
 extern const Kernels kSseKernels;
+extern const Kernels kAvx2Kernels;  // run only where cpu_has_avx2()
+
+inline bool cpu_has_avx2() { return __builtin_cpu_supports("avx2"); }
 
 inline std::uint32_t padded_neighbour_count(std::uint32_t count) { return (count + 3u) & ~3u; }
 

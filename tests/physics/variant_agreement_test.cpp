@@ -60,3 +60,20 @@ TEST_CASE("scalar and SSE settle into the same pile", "[physics][variants][slow]
   CHECK(scalar.pile_top() == Approx(sse.pile_top()).margin(1.5));
   CHECK(scalar.max_overlap_fraction() == Approx(sse.max_overlap_fraction()).margin(0.03));
 }
+
+TEST_CASE("the AVX2 build of the SSE kernels computes bit-identical states", "[physics][variants]") {
+  if (!cpu_has_avx2()) {
+    WARN("this processor has no AVX2; nothing to compare");
+    return;
+  }
+  // Same source, same operations on the same lanes, no contraction into FMA:
+  // only the instruction encoding differs, so the states must match exactly.
+  World sse(PhysicsParams{}, kSseKernels, 2, 8);
+  World avx2(PhysicsParams{}, kAvx2Kernels, 2, 8);
+  for (World* w : {&sse, &avx2}) {
+    w->add_balls(1500);
+    w->set_player_velocity(w->add_player(), {2.0f, -3.0f, 1.0f});
+    for (int s = 0; s < 3000; ++s) w->step();
+  }
+  CHECK(avx2.state_hash() == sse.state_hash());
+}
