@@ -2,6 +2,9 @@
 
 #include <GL/glew.h>
 #include <GLFW/glfw3.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #include <cstdio>
 #include <memory>
@@ -42,6 +45,19 @@ bool same_box(const TankBounds& a, const TankBounds& b) {
          a.max.y == b.max.y && a.max.z == b.max.z;
 }
 
+// Mesa's software renderer (llvmpipe, e.g. under Xvfb) mallocs and frees
+// megabytes of vertex data every frame. By default glibc gives that memory
+// back to the kernel after each free and page-faults it in again on the next
+// frame: measured here at 1000 balls, 3.5 fps with 70 % of the time in the
+// kernel, and 20 fps once freed memory stays with the process. A GPU driver
+// is unaffected either way.
+void keep_freed_memory() {
+#ifdef __GLIBC__
+  mallopt(M_TRIM_THRESHOLD, 256 << 20);
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);  // the largest glibc accepts on 64-bit
+#endif
+}
+
 void on_glfw_error(int code, const char* description) {
   std::fprintf(stderr, "fishtank-viewer: GLFW error %d: %s\n", code, description);
 }
@@ -69,6 +85,7 @@ class FullscreenToggle {
 }  // namespace
 
 int run_viewer(const ViewerOptions& opt) {
+  keep_freed_memory();
   glfwSetErrorCallback(on_glfw_error);
   GlfwSession glfw;
   if (!glfw.ok) {
@@ -123,6 +140,7 @@ int run_viewer(const ViewerOptions& opt) {
     while (!glfwWindowShouldClose(window)) {
       glfwPollEvents();
       const double frame_start = steady_seconds();
+      const double cpu_start = thread_cpu_seconds();
 
       Actions a = input.take_actions();
       if (a.quit) glfwSetWindowShouldClose(window, GLFW_TRUE);
@@ -165,7 +183,7 @@ int run_viewer(const ViewerOptions& opt) {
       view.show_help = show_help;
       view.now = frame_start;
       hud.build(view);
-      const double cpu_seconds = steady_seconds() - frame_start;
+      const double cpu_seconds = thread_cpu_seconds() - cpu_start;
 
       int width = 0, height = 0;
       glfwGetFramebufferSize(window, &width, &height);
@@ -193,7 +211,7 @@ int run_viewer(const ViewerOptions& opt) {
         }
       }
       glfwSwapBuffers(window);
-      stats.frame_done(steady_seconds(), cpu_seconds);
+      stats.frame_done(steady_seconds(), cpu_seconds, have_frame);
     }
 
     const std::shared_ptr<const Snapshot> last = snapshots.newest();

@@ -2,10 +2,12 @@
 
 namespace fishtank::viewer {
 
-void FrameStats::frame_done(double now, double cpu_seconds) {
-  if (total_frames_++ == 0) first_ = now;
-  last_ = now;
-  total_cpu_ += cpu_seconds;
+void FrameStats::frame_done(double now, double cpu_seconds, bool scene) {
+  if (scene) {
+    if (total_frames_++ == 0) first_ = now;
+    last_ = now;
+    total_cpu_ += cpu_seconds;
+  }
 
   window_.push_back({now, cpu_seconds});
   // Keep one frame older than a second: its end is where the oldest counted frame began.

@@ -1,7 +1,8 @@
 #pragma once
 // Frame rate, frame time and CPU time per frame, each measured over the last
 // second of real frames (SPEC 5.1: measured, not estimated), plus totals for
-// the summary printed at exit.
+// the summary printed at exit. The totals count only frames that drew the
+// scene, so start-up frames before the first snapshot do not flatter them.
 
 #include <cstdint>
 #include <deque>
@@ -10,15 +11,16 @@ namespace fishtank::viewer {
 
 class FrameStats {
  public:
-  // Once per frame: when it ended, and the CPU seconds it spent outside GL calls.
-  void frame_done(double now, double cpu_seconds);
+  // Once per frame: when it ended, the CPU seconds it spent outside GL calls,
+  // and whether it drew the scene.
+  void frame_done(double now, double cpu_seconds, bool scene);
 
   float fps() const { return fps_; }
   float frame_ms() const { return frame_ms_; }
   float cpu_ms() const { return cpu_ms_; }
 
   std::uint64_t total_frames() const { return total_frames_; }
-  double total_seconds() const { return last_ - first_; }
+  double total_seconds() const { return last_ - first_; }  // first to last scene frame
   double mean_cpu_ms() const {
     return total_frames_ ? 1e3 * total_cpu_ / static_cast<double>(total_frames_) : 0.0;
   }

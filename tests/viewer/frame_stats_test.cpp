@@ -8,7 +8,7 @@ using fishtank::viewer::FrameStats;
 
 TEST_CASE("frames every 1/60 s read as 60 fps and 16.7 ms, CPU time as the mean per frame") {
   FrameStats stats;
-  for (int i = 0; i <= 120; ++i) stats.frame_done(i / 60.0, 0.002);
+  for (int i = 0; i <= 120; ++i) stats.frame_done(i / 60.0, 0.002, true);
   CHECK(stats.fps() == Approx(60.0f).epsilon(1e-3));
   CHECK(stats.frame_ms() == Approx(1000.0f / 60.0f).epsilon(1e-3));
   CHECK(stats.cpu_ms() == Approx(2.0f).epsilon(1e-3));
@@ -18,7 +18,16 @@ TEST_CASE("frames every 1/60 s read as 60 fps and 16.7 ms, CPU time as the mean 
 TEST_CASE("the counter follows a change of rate within a second") {
   FrameStats stats;
   double t = 0.0;
-  for (int i = 0; i < 120; ++i) stats.frame_done(t += 1.0 / 60.0, 0.0);
-  for (int i = 0; i < 25; ++i) stats.frame_done(t += 1.0 / 20.0, 0.0);  // 1.25 s at 20 fps
+  for (int i = 0; i < 120; ++i) stats.frame_done(t += 1.0 / 60.0, 0.0, true);
+  for (int i = 0; i < 25; ++i) stats.frame_done(t += 1.0 / 20.0, 0.0, true);  // 1.25 s at 20 fps
   CHECK(stats.fps() == Approx(20.0f).epsilon(1e-3));
+}
+
+TEST_CASE("the exit summary counts only frames that drew the scene") {
+  FrameStats stats;
+  for (int i = 0; i < 10; ++i) stats.frame_done(i * 0.001, 0.0, false);  // waiting for the first snapshot
+  for (int i = 0; i <= 30; ++i) stats.frame_done(1.0 + i / 30.0, 0.001, true);
+  CHECK(stats.total_frames() == 31);
+  CHECK(stats.total_seconds() == Approx(1.0));
+  CHECK(stats.mean_cpu_ms() == Approx(1.0));
 }
