@@ -232,6 +232,7 @@ std::optional<DecodeResult> FrameReader::next() {
   std::uint32_t body_bytes = 0;
   if (DecodeResult r = check_length_prefix(pending_.data(), to_, &body_bytes); !r.ok()) {
     pending_.clear();
+    frame_.clear();
     broken_ = r;
     return broken_;
   }

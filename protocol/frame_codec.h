@@ -123,6 +123,7 @@ class FrameReader {
   // The result's message points into frame() and stays valid until the next call.
   // After a stream_broken() result, the reader returns that result forever.
   std::optional<DecodeResult> next();
+  // The frame of the last result; empty after a bad length prefix (no frame was cut).
   const Frame& frame() const { return frame_; }
 
  private:

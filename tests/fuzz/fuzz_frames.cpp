@@ -1,0 +1,90 @@
+// libFuzzer target: arbitrary bytes as a client's byte stream to the server,
+// and as a server's byte stream to a client.
+//
+//   bytes ─► FrameReader(to_server) ─► ClientProtocol::on_frame ─► replies, commands
+//        │                                 └ on_reply(Joined / BallsAdded) after a Join
+//        └─► FrameReader(to_client) ─► every field a client reads
+//
+// The first byte picks the chunk size the stream is cut into, so frame
+// boundaries land everywhere. A crash, a sanitizer report or an accepted frame
+// that fails to decode again is a bug.
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+
+#include "protocol/frame_codec.h"
+#include "server/net/client_protocol.h"
+
+using namespace fishtank;
+
+namespace {
+
+const net::ServerInfo kInfo{"sse", "sse4.1", 2, TankBounds{}, 0.001f, 60.0f};
+
+void check(bool ok) {
+  if (!ok) std::abort();
+}
+
+void drive_server(const std::uint8_t* data, std::size_t size, std::size_t chunk) {
+  protocol::FrameReader reader(protocol::Direction::to_server);
+  net::ClientProtocol conversation(1, kInfo);
+  for (std::size_t at = 0; at < size; at += chunk) {
+    reader.append(data + at, std::min(chunk, size - at));
+    while (auto decoded = reader.next()) {
+      const protocol::Frame& frame = reader.frame();
+      // bad_length comes from the prefix alone: there is no frame to hand over.
+      net::Outcome outcome = decoded->status == protocol::DecodeStatus::bad_length
+                                 ? conversation.on_broken_stream(*decoded)
+                                 : conversation.on_frame(frame.data(), frame.size());
+      for (const protocol::Frame& reply : outcome.replies)  // everything the server says must decode
+        check(protocol::decode_frame(reply.data(), reply.size(), protocol::Direction::to_client).ok());
+      if (outcome.command && std::holds_alternative<net::JoinCommand>(outcome.command->action)) {
+        net::Reply joined{1, net::JoinedReply{std::nullopt, "all player spheres are taken"}};
+        for (const protocol::Frame& reply : conversation.on_reply(joined).replies)
+          check(protocol::decode_frame(reply.data(), reply.size(), protocol::Direction::to_client).ok());
+      }
+      if (outcome.disconnect || decoded->stream_broken()) return;
+    }
+  }
+}
+
+// Reads every field of an accepted server message, as a client would.
+std::uint64_t read_all(const wire::Message& m) {
+  std::uint64_t sum = 0;
+  if (const auto* s = m.payload_as_Snapshot()) {
+    for (std::uint16_t q : *s->positions()) sum += q;
+    if (s->player_positions())
+      for (const wire::Vec3f* p : *s->player_positions()) sum += static_cast<std::uint64_t>(p->x() != 0.0f);
+  } else if (const auto* k = m.payload_as_BallKinds()) {
+    for (std::uint8_t kind : *k->kinds()) sum += kind;
+  } else if (const auto* w = m.payload_as_Welcome()) {
+    for (const wire::BallKindInfo* kind : *w->ball_kinds()) sum += kind->r();
+    sum += w->server_variant() ? w->server_variant()->size() : 0;
+  } else if (const auto* e = m.payload_as_Error()) {
+    sum += e->message()->size();
+  }
+  return sum;
+}
+
+void drive_client(const std::uint8_t* data, std::size_t size, std::size_t chunk) {
+  protocol::FrameReader reader(protocol::Direction::to_client);
+  volatile std::uint64_t sink = 0;
+  for (std::size_t at = 0; at < size; at += chunk) {
+    reader.append(data + at, std::min(chunk, size - at));
+    while (auto decoded = reader.next()) {
+      if (decoded->stream_broken()) return;
+      if (decoded->ok()) sink = sink + read_all(*decoded->message);
+    }
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size < 1) return 0;
+  const std::size_t chunk = 1 + data[0] % 64 * 17;  // 1 .. 1072 bytes per read
+  drive_server(data + 1, size - 1, chunk);
+  drive_client(data + 1, size - 1, chunk);
+  return 0;
+}

@@ -1,0 +1,59 @@
+// Writes the fuzzer's seed corpus: one file per valid frame of every message
+// type (and one stream of several), each preceded by the chunk-size byte that
+// fuzz_frames.cpp reads first. Usage: make_seed_corpus DIRECTORY
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "protocol/frame_codec.h"
+
+using namespace fishtank;
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: make_seed_corpus DIRECTORY\n");
+    return 2;
+  }
+  protocol::WelcomeInfo welcome;
+  welcome.server_variant = "sse";
+  welcome.simd_level = "sse4.1";
+  welcome.dt = 0.000785f;
+  welcome.player_id = 0;
+  const std::uint16_t positions[9] = {0, 100, 65535, 32768, 0, 1, 2, 3, 4};
+  const std::uint8_t kinds[3] = {0, 1, 2};
+  const std::uint32_t player_ids[1] = {0};
+  const Vec3 players[1] = {{0.0f, 20.0f, 0.0f}};
+  protocol::SnapshotHeader header;
+  header.tick = 5;
+  header.sim_time = 1.25;
+
+  const std::vector<std::pair<std::string, protocol::Frame>> frames = {
+      {"hello", protocol::encode_hello("seed", true)},
+      {"hello_observer", protocol::encode_hello("seed", false)},
+      {"player_input", protocol::encode_player_input(1, {1.0f, -2.0f, 3.0f})},
+      {"add_balls", protocol::encode_add_balls(1000)},
+      {"ping", protocol::encode_ping(123456)},
+      {"welcome", protocol::encode_welcome(welcome)},
+      {"ball_kinds", protocol::encode_ball_kinds(0, kinds, 3)},
+      {"snapshot", protocol::encode_snapshot(header, positions, 3, player_ids, players, 1)},
+      {"error", protocol::encode_error(wire::ErrorCode::tank_full, "added 10 of 20 balls")},
+      {"pong", protocol::encode_pong(123456)},
+  };
+  protocol::Frame conversation{0};  // chunk byte 0: one byte at a time
+  for (const char* name : {"hello", "player_input", "add_balls", "ping"})
+    for (const auto& [n, f] : frames)
+      if (n == name) conversation.insert(conversation.end(), f.begin(), f.end());
+
+  const std::string dir = argv[1];
+  for (const auto& [name, frame] : frames) {
+    std::ofstream out(dir + "/" + name, std::ios::binary);
+    const char chunk_byte = 63;  // the largest chunk: whole frames at once
+    out.write(&chunk_byte, 1);
+    out.write(reinterpret_cast<const char*>(frame.data()), static_cast<std::streamsize>(frame.size()));
+  }
+  std::ofstream(dir + "/conversation", std::ios::binary)
+      .write(reinterpret_cast<const char*>(conversation.data()), static_cast<std::streamsize>(conversation.size()));
+  return 0;
+}

@@ -1,0 +1,310 @@
+// fishtank-server as a daemon: a real server process on an ephemeral
+// 127.0.0.1 port, real TCP clients. Each test names the fact it checks; every
+// wait is bounded, so a broken server fails a test instead of hanging it.
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "client/connection.h"
+#include "protocol/frame_codec.h"
+#include "server_process.h"
+
+using namespace fishtank;
+using client::Connection;
+using test::RawSocket;
+using test::ServerProcess;
+using Clock = std::chrono::steady_clock;
+namespace asio = boost::asio;
+
+namespace {
+
+// Connections sharing one io_context, pumped by the test thread.
+class Clients {
+ public:
+  explicit Clients(std::uint16_t port) : server_(asio::ip::make_address("127.0.0.1"), port) {}
+
+  std::shared_ptr<Connection> add(bool wants_player, std::uint32_t version = protocol::kProtocolVersion) {
+    auto c = std::make_shared<Connection>(io_, "test-" + std::to_string(all_.size() + 1), wants_player);
+    c->start(server_, version);
+    all_.push_back(c);
+    return c;
+  }
+  void run_for(std::chrono::milliseconds d) {
+    io_.restart();
+    io_.run_for(d);
+  }
+  // Pumps until done() or the timeout; returns done().
+  bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
+    const Clock::time_point deadline = Clock::now() + timeout;
+    while (!done() && Clock::now() < deadline) run_for(std::chrono::milliseconds(10));
+    return done();
+  }
+  bool all_welcomed() const {
+    return std::all_of(all_.begin(), all_.end(), [](auto& c) { return c->welcomed(); });
+  }
+  ~Clients() {
+    for (auto& c : all_) c->close();
+    run_for(std::chrono::milliseconds(50));
+  }
+
+ private:
+  asio::io_context io_;
+  asio::ip::tcp::endpoint server_;
+  std::vector<std::shared_ptr<Connection>> all_;
+};
+
+bool has_error(const Connection& c, const std::string& code) {
+  return std::any_of(c.stats().errors.begin(), c.stats().errors.end(),
+                     [&](const std::string& e) { return e.rfind(code, 0) == 0; });
+}
+
+// Every connection's snapshot count over `seconds` of pumping, as a rate.
+std::vector<double> measure_rates(Clients& clients, const std::vector<std::shared_ptr<Connection>>& of,
+                                  double seconds) {
+  std::vector<std::uint64_t> before;
+  for (auto& c : of) before.push_back(c->stats().snapshots);
+  clients.run_for(std::chrono::milliseconds(static_cast<int>(seconds * 1000)));
+  std::vector<double> rates;
+  for (std::size_t i = 0; i < of.size(); ++i) rates.push_back((of[i]->stats().snapshots - before[i]) / seconds);
+  return rates;
+}
+
+protocol::Frame frame_with_length(std::uint32_t length, std::size_t body_bytes) {
+  protocol::Frame f(4 + body_bytes, 0xAB);
+  for (int i = 0; i < 4; ++i) f[i] = static_cast<std::uint8_t>(length >> (8 * i));
+  return f;
+}
+
+// The first Error code in what a raw socket received (empty if none).
+std::string first_error_code(const std::vector<std::uint8_t>& bytes) {
+  protocol::FrameReader reader(protocol::Direction::to_client);
+  reader.append(bytes.data(), bytes.size());
+  while (auto r = reader.next()) {
+    if (!r->ok()) return {};
+    if (r->message->payload_type() == wire::Payload::Error)
+      return wire::EnumNameErrorCode(r->message->payload_as_Error()->code());
+  }
+  return {};
+}
+
+}  // namespace
+
+TEST_CASE("several clients each receive snapshots at the snapshot rate, and the server stops cleanly on SIGTERM",
+          "[net]") {
+  ServerProcess server({"--balls", "500", "--snapshot-rate", "60"});
+  Clients clients(server.port());
+  std::vector<std::shared_ptr<Connection>> all;
+  for (int i = 0; i < 4; ++i) all.push_back(clients.add(/*wants_player=*/i % 2 == 0));
+  REQUIRE(clients.wait_until([&] { return clients.all_welcomed(); }, std::chrono::seconds(5)));
+  clients.run_for(std::chrono::milliseconds(200));
+  for (double rate : measure_rates(clients, all, 1.5)) {
+    CHECK(rate > 45.0);  // 60 Hz asked; generous for a loaded 2-core machine
+    CHECK(rate < 70.0);
+  }
+  for (auto& c : all) {
+    CHECK(c->stats().errors.empty());
+    CHECK(c->view().ball_count > 0);
+    CHECK(c->view().kinds.size() >= c->view().ball_count);  // every ball's kind arrived before the ball
+  }
+  CHECK(all[0]->player_id().has_value());
+  CHECK_FALSE(all[1]->player_id().has_value());  // observers get no sphere
+  CHECK(server.terminate() == 0);
+}
+
+TEST_CASE("AddBalls raises the ball count that every client sees; beyond room it gets an Error saying why", "[net]") {
+  ServerProcess server({"--balls", "0", "--max-balls", "300"});
+  Clients clients(server.port());
+  auto adder = clients.add(false);
+  auto watcher1 = clients.add(false);
+  auto watcher2 = clients.add(true);
+  REQUIRE(clients.wait_until([&] { return clients.all_welcomed(); }, std::chrono::seconds(5)));
+  REQUIRE(clients.wait_until([&] { return watcher1->stats().snapshots > 0; }, std::chrono::seconds(5)));
+  CHECK(watcher1->view().ball_count == 0);
+
+  adder->send(protocol::encode_add_balls(200));
+  const auto all_see = [&](std::uint32_t n) {
+    return adder->view().ball_count >= n && watcher1->view().ball_count >= n && watcher2->view().ball_count >= n;
+  };
+  CHECK(clients.wait_until([&] { return all_see(200); }, std::chrono::seconds(10)));
+  CHECK(adder->stats().errors.empty());
+
+  adder->send(protocol::encode_add_balls(500));  // only 100 more fit under --max-balls 300
+  REQUIRE(clients.wait_until([&] { return !adder->stats().errors.empty(); }, std::chrono::seconds(5)));
+  CHECK(has_error(*adder, "tank_full"));
+  CHECK_THAT(adder->stats().errors.front(), Catch::Contains("100"));
+  CHECK(clients.wait_until([&] { return all_see(300); }, std::chrono::seconds(10)));
+  CHECK(watcher1->view().kinds.size() >= 300);
+  CHECK(watcher1->stats().errors.empty());
+}
+
+TEST_CASE("PlayerInput moves that client's sphere, which pushes the balls it touches; leaving removes it", "[net]") {
+  ServerProcess server({"--balls", "400"});
+  Clients clients(server.port());
+  auto player = clients.add(true);
+  auto observer = clients.add(false);
+  REQUIRE(clients.wait_until([&] { return clients.all_welcomed(); }, std::chrono::seconds(5)));
+  REQUIRE(player->player_id());
+  const std::uint32_t id = *player->player_id();
+  REQUIRE(clients.wait_until([&] { return observer->view().ball_count == 400; }, std::chrono::seconds(10)));
+
+  const auto positions = [&] {
+    std::vector<Vec3> p;
+    for (std::uint32_t b = 0; b < observer->view().ball_count; ++b) p.push_back(observer->ball_position(b));
+    return p;
+  };
+  const auto moved_more_than = [](const std::vector<Vec3>& a, const std::vector<Vec3>& b, float d) {
+    int n = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) n += length(a[i] - b[i]) > d;
+    return n;
+  };
+  // Control: wait until the pile has settled, i.e. while the sphere stands
+  // still no ball moves more than 0.3 units in half a second.
+  std::vector<Vec3> rest = positions();
+  bool settled = false;
+  for (int tries = 0; tries < 30 && !settled; ++tries) {
+    clients.run_for(std::chrono::milliseconds(500));
+    std::vector<Vec3> now = positions();
+    settled = moved_more_than(rest, now, 0.3f) == 0;
+    rest = std::move(now);
+  }
+  REQUIRE(settled);
+
+  const Vec3 start = *observer->player_position(id);
+  player->send(protocol::encode_player_input(1, {0.0f, -10.0f, 0.0f}));  // down into the pile...
+  clients.run_for(std::chrono::milliseconds(2200));
+  const Vec3 low = *observer->player_position(id);
+  CHECK(low.y < start.y - 10.0f);
+  player->send(protocol::encode_player_input(2, {10.0f, 0.0f, 0.0f}));  // ...and through it along +x
+  clients.run_for(std::chrono::milliseconds(1200));
+  player->send(protocol::encode_player_input(3, {0.0f, 0.0f, 0.0f}));
+  clients.run_for(std::chrono::milliseconds(200));
+  const Vec3 end = *observer->player_position(id);
+  CHECK(end.x > low.x + 8.0f);
+  CHECK(moved_more_than(rest, positions(), 0.3f) >= 3);
+  CHECK(player->stats().errors.empty());
+
+  player->close();
+  CHECK(clients.wait_until([&] { return !observer->player_position(id); }, std::chrono::seconds(5)));
+}
+
+TEST_CASE("NaN and infinite input gets an Error and is ignored; the connection stays", "[net]") {
+  ServerProcess server({"--balls", "0"});
+  Clients clients(server.port());
+  auto player = clients.add(true);
+  REQUIRE(clients.wait_until([&] { return player->welcomed(); }, std::chrono::seconds(5)));
+  player->send(protocol::encode_player_input(1, {std::nanf(""), 0.0f, 0.0f}));
+  player->send(protocol::encode_player_input(2, {0.0f, INFINITY, 0.0f}));
+  REQUIRE(clients.wait_until([&] { return player->stats().errors.size() >= 2; }, std::chrono::seconds(5)));
+  CHECK(has_error(*player, "invalid_value"));
+  const std::uint64_t before = player->stats().snapshots;
+  clients.run_for(std::chrono::milliseconds(300));
+  CHECK(player->stats().snapshots > before);
+  CHECK_FALSE(player->closed());
+  const Vec3 p = *player->player_position(*player->player_id());
+  CHECK(is_finite(p));
+}
+
+TEST_CASE("a protocol version mismatch is refused with a clear Error and a disconnect", "[net]") {
+  ServerProcess server({"--balls", "0"});
+  Clients clients(server.port());
+  auto old_client = clients.add(true, protocol::kProtocolVersion + 41);
+  REQUIRE(clients.wait_until([&] { return old_client->closed(); }, std::chrono::seconds(5)));
+  CHECK_FALSE(old_client->welcomed());
+  REQUIRE(has_error(*old_client, "version_mismatch"));
+  CHECK_THAT(old_client->stats().errors.front(), Catch::Contains("protocol version"));
+}
+
+TEST_CASE("more clients than --max-players: the extra one observes and is told so", "[net]") {
+  ServerProcess server({"--balls", "0", "--max-players", "1"});
+  Clients clients(server.port());
+  auto first = clients.add(true);
+  REQUIRE(clients.wait_until([&] { return first->welcomed(); }, std::chrono::seconds(5)));
+  auto second = clients.add(true);
+  REQUIRE(clients.wait_until([&] { return second->welcomed(); }, std::chrono::seconds(5)));
+  CHECK(first->player_id().has_value());
+  CHECK_FALSE(second->player_id().has_value());
+  CHECK(has_error(*second, "player_limit"));
+}
+
+TEST_CASE("bad bytes from one client: Error and disconnect for it; the server and other clients carry on", "[net]") {
+  ServerProcess server({"--balls", "300"});
+  Clients clients(server.port());
+  auto watcher = clients.add(false);
+  REQUIRE(clients.wait_until([&] { return watcher->stats().snapshots > 5; }, std::chrono::seconds(5)));
+  const long rss_before = server.rss_kb();
+
+  SECTION("garbage: an HTTP request") {
+    RawSocket raw(server.port());
+    const std::string http = "GET / HTTP/1.1\r\nHost: x\r\n\r\n";
+    raw.send(std::vector<std::uint8_t>(http.begin(), http.end()));
+    std::vector<std::uint8_t> got;
+    CHECK(raw.read_until_closed(got, std::chrono::seconds(5)));
+    CHECK(first_error_code(got) == "malformed_frame");
+  }
+  SECTION("garbage: a plausible length followed by random bytes") {
+    RawSocket raw(server.port());
+    raw.send(frame_with_length(64, 64));
+    std::vector<std::uint8_t> got;
+    CHECK(raw.read_until_closed(got, std::chrono::seconds(5)));
+    CHECK(first_error_code(got) == "malformed_frame");
+  }
+  SECTION("an oversized length prefix (2 GiB) is refused without allocating it") {
+    RawSocket raw(server.port());
+    raw.send(frame_with_length(0x7fffffffu, 16));
+    std::vector<std::uint8_t> got;
+    CHECK(raw.read_until_closed(got, std::chrono::seconds(5)));
+    CHECK(first_error_code(got) == "malformed_frame");
+    CHECK(server.rss_kb() < rss_before + 50 * 1024);
+  }
+  SECTION("a valid frame before Hello is refused") {
+    RawSocket raw(server.port());
+    raw.send(protocol::encode_ping(1));
+    std::vector<std::uint8_t> got;
+    CHECK(raw.read_until_closed(got, std::chrono::seconds(5)));
+    CHECK(first_error_code(got) == "expected_hello");
+  }
+  SECTION("half a frame, then the client disconnects") {
+    RawSocket raw(server.port());
+    const protocol::Frame hello = protocol::encode_hello("half", true);
+    raw.send(protocol::Frame(hello.begin(), hello.begin() + static_cast<long>(hello.size() / 2)));
+    clients.run_for(std::chrono::milliseconds(100));
+    raw.close();
+  }
+
+  // The watcher kept receiving at its rate, and the server is up and accepts newcomers.
+  const double rate = measure_rates(clients, {watcher}, 1.0).front();
+  CHECK(rate > 45.0);
+  CHECK(server.running());
+  auto newcomer = clients.add(true);
+  CHECK(clients.wait_until([&] { return newcomer->stats().snapshots > 0; }, std::chrono::seconds(5)));
+  CHECK(watcher->stats().errors.empty());
+}
+
+TEST_CASE("clients that never read: the server's memory stays bounded and others keep their snapshot rate", "[net]") {
+  // 2000 balls at 120 Hz: 12 kB a snapshot. Four stalled clients with unbounded
+  // queues would pile up 4 x 120 x 12 kB = 5.8 MB every second.
+  ServerProcess server({"--balls", "2000", "--snapshot-rate", "120"});
+  Clients clients(server.port());
+  auto watcher = clients.add(false);
+  REQUIRE(clients.wait_until([&] { return watcher->view().ball_count > 1500; }, std::chrono::seconds(15)));
+
+  std::vector<std::unique_ptr<RawSocket>> stalled;
+  for (int i = 0; i < 4; ++i) {
+    stalled.push_back(std::make_unique<RawSocket>(server.port(), /*receive_buffer=*/4096));
+    stalled.back()->send(protocol::encode_hello("stalled", false));
+  }
+  clients.run_for(std::chrono::milliseconds(1500));  // their socket buffers fill up
+  const long rss_start = server.rss_kb();
+  const double rate = measure_rates(clients, {watcher}, 3.0).front();
+  const long rss_end = server.rss_kb();
+  INFO("server RSS " << rss_start << " kB -> " << rss_end << " kB");
+  CHECK(rss_end - rss_start < 4 * 1024);  // unbounded queues would add ~17 MB here
+  CHECK(rate > 90.0);                     // 120 Hz asked
+  CHECK(server.running());
+  CHECK(watcher->stats().errors.empty());
+}
