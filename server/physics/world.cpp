@@ -26,6 +26,11 @@ class PhaseTimer {
   std::chrono::steady_clock::time_point start_;
 };
 
+double ball_energy(const Float4& pos, const Float4& vel, float gravity) {
+  const double speed2 = double(vel.x) * vel.x + double(vel.y) * vel.y + double(vel.z) * vel.z;
+  return 0.5 * vel.w * speed2 + double(vel.w) * gravity * pos.y;
+}
+
 template <class Vector>
 void apply_order(Vector& v, const std::vector<std::uint32_t>& order, Vector& scratch) {
   scratch.resize(v.size());
@@ -90,6 +95,7 @@ void World::place_ball(int kind, Vec3 p, Vec3 v) {
   acc_[i] = {0.0f, -model_.gravity, 0.0f, 0.0f};
   kind_[i] = static_cast<std::uint8_t>(kind);
   id_[i] = next_id_++;
+  energy_added_ += ball_energy(pos_[i], vel_[i], model_.gravity);
   needs_rebuild_ = true;
   needs_initial_forces_ = true;
 }
@@ -162,6 +168,7 @@ void World::spawn() {
     acc_[i] = {0.0f, -model_.gravity, 0.0f, 0.0f};
     kind_[i] = static_cast<std::uint8_t>(placed_[b].kind);
     id_[i] = next_id_++;
+    energy_added_ += ball_energy(pos_[i], vel_[i], model_.gravity);
   }
   needs_rebuild_ = true;
 }
@@ -262,10 +269,7 @@ BallView World::ball(std::uint32_t id) const {
 
 double World::kinetic_energy() const {
   double e = 0.0;
-  for (std::uint32_t i = 0; i < n_; ++i) {
-    const Float4& v = vel_[i];
-    e += 0.5 * v.w * (double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z);
-  }
+  for (std::uint32_t i = 0; i < n_; ++i) e += ball_energy(pos_[i], vel_[i], 0.0f);
   return e;
 }
 
@@ -273,6 +277,26 @@ double World::potential_energy() const {
   double e = 0.0;
   for (std::uint32_t i = 0; i < n_; ++i) e += double(vel_[i].w) * model_.gravity * pos_[i].y;
   return e;
+}
+
+double World::elastic_energy() const {
+  if (needs_rebuild_) return 0.0;  // no lists yet: nothing has been stepped
+  const TankBounds& t = params_.tank;
+  double sum_x2 = 0.0;
+  for (std::uint32_t i = 0; i < n_; ++i) {
+    const Float4& p = pos_[i];
+    const std::uint32_t* list = list_.neighbours() + std::size_t(i) * list_.stride();
+    for (std::uint32_t n = 0; n < list_.counts()[i]; ++n) {
+      const Float4& q = pos_[list[n]];
+      double dx = p.x - q.x, dy = p.y - q.y, dz = p.z - q.z;
+      double overlap = p.w + q.w - std::sqrt(dx * dx + dy * dy + dz * dz);
+      if (overlap > 0.0) sum_x2 += 0.5 * overlap * overlap;  // each pair is listed from both sides
+    }
+    for (double overlap : {t.min.x + p.w - p.x, p.x + p.w - t.max.x, t.min.y + p.w - p.y, p.y + p.w - t.max.y,
+                           t.min.z + p.w - p.z, p.z + p.w - t.max.z})
+      if (overlap > 0.0) sum_x2 += overlap * overlap;
+  }
+  return 0.5 * model_.k * sum_x2;
 }
 
 float World::max_overlap_fraction() const {

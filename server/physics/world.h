@@ -96,6 +96,10 @@ class World {
 
   double kinetic_energy() const;
   double potential_energy() const;  // gravity, relative to y = 0
+  double elastic_energy() const;    // springs of every contact: sum of k x^2 / 2
+  // Kinetic plus gravitational energy of every ball at the moment it appeared:
+  // with no player moving, the world's total energy can never exceed it.
+  double energy_added() const { return energy_added_; }
   // Largest overlap (ball-ball, ball-wall), as a fraction of the smaller radius.
   float max_overlap_fraction() const;
   float pile_top() const;  // highest point of any ball
@@ -143,6 +147,7 @@ class World {
   std::vector<std::uint32_t> order_;
   std::vector<NewBall> placed_;
   double time_ = 0.0;
+  double energy_added_ = 0.0;
   std::uint64_t steps_ = 0;
   std::uint64_t rebuilds_ = 0;
   PhaseSeconds phase_seconds_;
