@@ -212,6 +212,9 @@ DecodeResult decode_frame(const std::uint8_t* frame, std::size_t size, Direction
     return failure(DecodeStatus::malformed, "frame failed FlatBuffers verification");
   const wire::Message* message = wire::GetSizePrefixedMessage(frame);
   if (message->payload_type() == wire::Payload::NONE) return failure(DecodeStatus::invalid_value, "empty message");
+  // The Verifier accepts a union type without its table (found by the fuzzer):
+  // every payload_as_*() would then return null.
+  if (!message->payload()) return failure(DecodeStatus::invalid_value, "message has a type but no body");
   if (!accepted_by(message->payload_type(), to))
     return failure(DecodeStatus::wrong_direction,
                    std::string("message type ") +

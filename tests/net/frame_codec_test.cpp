@@ -136,6 +136,12 @@ TEST_CASE("frames a peer got wrong are refused with a status that says whether t
     CHECK(decode(protocol::encode_pong(1), Direction::to_server).status == DecodeStatus::wrong_direction);
     CHECK(decode(protocol::encode_ping(1), Direction::to_client).status == DecodeStatus::wrong_direction);
   }
+  SECTION("a union type without its table is an invalid value, not a null dereference (found by fuzzing)") {
+    flatbuffers::FlatBufferBuilder b;
+    b.FinishSizePrefixed(wire::CreateMessage(b, wire::Payload::Hello, /*payload=*/0), "FTNK");
+    const protocol::Frame f(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize());
+    CHECK(decode(f, Direction::to_server).status == DecodeStatus::invalid_value);
+  }
   SECTION("a snapshot whose position count disagrees with its ball count is invalid") {
     flatbuffers::FlatBufferBuilder b;
     const std::uint16_t q[6] = {};
