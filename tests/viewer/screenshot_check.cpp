@@ -75,6 +75,7 @@ int main(int argc, char** argv) {
   ok &= expect(c.blue >= 100, "blue balls (diameter 3) are visible");
   ok &= expect(c.white >= 20, "the white player sphere is visible");
   ok &= expect(c.white < 0.01 * n, "white is only the small player sphere (under 1 % of the picture)");
-  ok &= expect(c.blue > c.red && c.green > c.red, "blue and green balls cover more pixels than the small red ones");
+  ok &= expect(c.blue > c.red && c.green > c.red,
+               "blue and green balls cover more pixels than the small red ones");
   return ok ? 0 : 1;
 }
