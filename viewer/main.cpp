@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
       ("no-hud", "start with the statistics hidden (F1 toggles)")                                       //
       ("outline", po::bool_switch(&opt.tank_outline), "start with the tank's edges shown (T toggles)")  //
       ("screenshot", po::value(&opt.screenshot),
-       "render --frames frames after the first snapshot, save them "
+       "render --frames frames after the first snapshot, save the last "
        "as this PNG file and exit")  //
       ("frames", po::value(&opt.frames), "frames to render before --screenshot (default 1)");
   po::variables_map vm;
@@ -46,6 +46,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   opt.host = connect.substr(0, colon);
+  if (opt.host.size() > 2 && opt.host.front() == '[' && opt.host.back() == ']')  // [::1]:7878
+    opt.host = opt.host.substr(1, opt.host.size() - 2);
   opt.port = connect.substr(colon + 1);
   if (opt.frames < 1) {
     std::fprintf(stderr, "fishtank-viewer: --frames must be at least 1\n");
