@@ -1,5 +1,7 @@
 #include "client/connection.h"
 
+#include <algorithm>
+
 #include "protocol/quantize.h"
 
 namespace fishtank::client {
@@ -103,6 +105,13 @@ void Connection::handle(const wire::Message& message) {
       view_.tick = s.tick();
       view_.sim_time = s.sim_time();
       view_.ball_count = s.ball_count();
+      const std::size_t common = std::min<std::size_t>(view_.positions.size(), s.positions()->size()) / 3;
+      std::size_t at_rest = 0;
+      for (std::size_t b = 0; b < common; ++b)
+        at_rest += view_.positions[3 * b] == s.positions()->Get(3 * b) &&
+                   view_.positions[3 * b + 1] == s.positions()->Get(3 * b + 1) &&
+                   view_.positions[3 * b + 2] == s.positions()->Get(3 * b + 2);
+      stats_.at_rest_fraction = common ? static_cast<double>(at_rest) / common : 0.0;
       view_.positions.assign(s.positions()->begin(), s.positions()->end());
       view_.player_ids.clear();
       view_.player_positions.clear();

@@ -23,6 +23,9 @@ struct ConnectionStats {
   std::uint64_t skipped_snapshots = 0;  // gaps in Snapshot.tick
   std::vector<double> rtt_ms;           // one per Pong
   std::vector<std::string> errors;      // Error messages, "code: message"
+  // Of the balls in both of the last two snapshots, the fraction whose quantised
+  // position did not change: what an at-rest (delta) encoding could leave out.
+  double at_rest_fraction = 0.0;
   std::optional<std::chrono::steady_clock::time_point> first_snapshot, last_snapshot;
 };
 

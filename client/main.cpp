@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
                         {"bytes_per_s", s.bytes_per_s},
                         {"rtt_ms", s.rtt_ms},
                         {"balls", s.balls},
+                        {"at_rest_fraction", s.at_rest_fraction},
                         {"errors", s.error_messages.size()},
                         {"error_messages", s.error_messages}};
     std::cout << j.dump() << std::endl;

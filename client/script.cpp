@@ -38,6 +38,7 @@ Summary summarise(const std::vector<std::shared_ptr<Connection>>& connections, d
     if (st.snapshots > 0 && c->view().tick >= newest_tick) {
       newest_tick = c->view().tick;
       s.balls = c->view().ball_count;
+      s.at_rest_fraction = st.at_rest_fraction;
     }
     if (!c->welcomed() && !c->close_reason().empty()) s.error_messages.push_back("connection: " + c->close_reason());
   }

@@ -32,6 +32,7 @@ struct Summary {
   double bytes_per_s = 0.0;       // mean per client
   double rtt_ms = 0.0;            // median over every Pong; 0 without any
   std::uint32_t balls = 0;        // newest ball count seen
+  double at_rest_fraction = 0.0;  // in that newest snapshot (ConnectionStats::at_rest_fraction)
   std::vector<std::string> error_messages;
   std::string connect_error;  // non-empty when no connection could be made
 };

@@ -72,6 +72,7 @@ std::string check_values(const wire::Message& m) {
       return {};
     case wire::Payload::Welcome: {
       const wire::Welcome& w = *m.payload_as_Welcome();
+      if (!w.server_variant() || !w.simd_level()) return "Welcome lacks server_variant or simd_level";
       if (!finite(w.tank_min()) || !finite(w.tank_max())) return "Welcome tank bounds are missing or not finite";
       if (!(w.tank_min()->x() < w.tank_max()->x() && w.tank_min()->y() < w.tank_max()->y() &&
             w.tank_min()->z() < w.tank_max()->z()))
@@ -92,16 +93,16 @@ std::string check_values(const wire::Message& m) {
     }
     case wire::Payload::Snapshot: {
       const wire::Snapshot& s = *m.payload_as_Snapshot();
-      const std::uint64_t values = s.positions() ? s.positions()->size() : 0;
+      if (!s.positions() || !s.player_ids() || !s.player_positions())
+        return "Snapshot lacks its positions, player_ids or player_positions vector";
+      const std::uint64_t values = s.positions()->size();
       if (values != 3 * std::uint64_t{s.ball_count()})
         return "Snapshot has " + std::to_string(values) + " position values for " + std::to_string(s.ball_count()) +
                " balls (3 per ball expected)";
-      const std::size_t ids = s.player_ids() ? s.player_ids()->size() : 0;
-      const std::size_t positions = s.player_positions() ? s.player_positions()->size() : 0;
-      if (ids != positions) return "Snapshot player_ids and player_positions differ in length";
-      if (s.player_positions())
-        for (const wire::Vec3f* p : *s.player_positions())
-          if (!finite(p)) return "Snapshot has a non-finite player position";
+      if (s.player_ids()->size() != s.player_positions()->size())
+        return "Snapshot player_ids and player_positions differ in length";
+      for (const wire::Vec3f* p : *s.player_positions())
+        if (!finite(p)) return "Snapshot has a non-finite player position";
       if (!std::isfinite(s.sim_time()) || !std::isfinite(s.steps_per_s()) || !std::isfinite(s.load()))
         return "Snapshot has a non-finite time, rate or load";
       return {};

@@ -12,6 +12,9 @@
 //   2. decode_frame: FlatBuffers Verifier (tight max_depth / max_tables), then the
 //      values: finite floats, counts in range, vector lengths that agree, and a
 //      payload type that the receiving side accepts.
+// When decoding is ok, the payload table and every field a reader needs are
+// present (the Verifier alone allows them to be absent): Hello.client_name may
+// be null; everything else in fishtank.fbs may be dereferenced.
 // A bad length or a failed verification breaks the stream (stream_broken()): the
 // reader cannot tell where the next frame starts, so it should disconnect.
 

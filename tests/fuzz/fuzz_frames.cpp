@@ -54,13 +54,13 @@ std::uint64_t read_all(const wire::Message& m) {
   std::uint64_t sum = 0;
   if (const auto* s = m.payload_as_Snapshot()) {
     for (std::uint16_t q : *s->positions()) sum += q;
-    if (s->player_positions())
-      for (const wire::Vec3f* p : *s->player_positions()) sum += static_cast<std::uint64_t>(p->x() != 0.0f);
+    for (const wire::Vec3f* p : *s->player_positions()) sum += static_cast<std::uint64_t>(p->x() != 0.0f);
+    for (std::uint32_t id : *s->player_ids()) sum += id;
   } else if (const auto* k = m.payload_as_BallKinds()) {
     for (std::uint8_t kind : *k->kinds()) sum += kind;
   } else if (const auto* w = m.payload_as_Welcome()) {
     for (const wire::BallKindInfo* kind : *w->ball_kinds()) sum += kind->r();
-    sum += w->server_variant() ? w->server_variant()->size() : 0;
+    sum += w->server_variant()->size() + w->simd_level()->size() + static_cast<std::uint64_t>(w->tank_min()->x());
   } else if (const auto* e = m.payload_as_Error()) {
     sum += e->message()->size();
   }

@@ -142,11 +142,20 @@ TEST_CASE("frames a peer got wrong are refused with a status that says whether t
     const protocol::Frame f(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize());
     CHECK(decode(f, Direction::to_server).status == DecodeStatus::invalid_value);
   }
+  SECTION("a snapshot without its positions vector is invalid, even with no balls (found by fuzzing)") {
+    flatbuffers::FlatBufferBuilder b;
+    const auto snapshot = wire::CreateSnapshot(b, 0, 0.0, 0, 0.0f, 0.0f, /*ball_count=*/0);
+    b.FinishSizePrefixed(wire::CreateMessage(b, wire::Payload::Snapshot, snapshot.Union()), "FTNK");
+    const protocol::Frame f(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize());
+    CHECK(decode(f, Direction::to_client).status == DecodeStatus::invalid_value);
+  }
   SECTION("a snapshot whose position count disagrees with its ball count is invalid") {
     flatbuffers::FlatBufferBuilder b;
     const std::uint16_t q[6] = {};
     const auto positions = b.CreateVector(q, 6);
-    const auto snapshot = wire::CreateSnapshot(b, 0, 0.0, 0, 0.0f, 0.0f, /*ball_count=*/3, positions);
+    const auto ids = b.CreateVector(std::vector<std::uint32_t>{});
+    const auto players = b.CreateVectorOfStructs(std::vector<wire::Vec3f>{});
+    const auto snapshot = wire::CreateSnapshot(b, 0, 0.0, 0, 0.0f, 0.0f, /*ball_count=*/3, positions, ids, players);
     b.FinishSizePrefixed(wire::CreateMessage(b, wire::Payload::Snapshot, snapshot.Union()), "FTNK");
     const protocol::Frame f(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize());
     CHECK(decode(f, Direction::to_client).status == DecodeStatus::invalid_value);
