@@ -22,7 +22,7 @@ void Session::start() {
 void Session::do_read_header() {
   asio::async_read(socket_, asio::buffer(header_),
                    [this, self = shared_from_this()](boost::system::error_code ec, std::size_t) {
-                     if (ec) return close(ec == asio::error::eof ? "disconnected" : ec.message());
+                     if (ec) return on_error(ec, "disconnected");
                      std::uint32_t body_bytes = 0;
                      protocol::DecodeResult length =
                          protocol::check_length_prefix(header_.data(), protocol::Direction::to_server, &body_bytes);
@@ -37,7 +37,7 @@ void Session::do_read_body(std::uint32_t body_bytes) {
   std::copy(header_.begin(), header_.end(), incoming_.begin());
   asio::async_read(socket_, asio::buffer(incoming_.data() + protocol::kLengthPrefixBytes, body_bytes),
                    [this, self = shared_from_this()](boost::system::error_code ec, std::size_t) {
-                     if (ec) return close(ec == asio::error::eof ? "disconnected mid-frame" : ec.message());
+                     if (ec) return on_error(ec, "disconnected mid-frame");
                      carry_out(protocol_.on_frame(incoming_.data(), incoming_.size()));
                      if (!close_after_write_ && !closed_) do_read_header();
                    });
@@ -97,10 +97,15 @@ void Session::do_write() {
     writing_replies_.clear();
     writing_kinds_.clear();
     writing_snapshot_.reset();
-    if (ec) return close(ec == asio::error::operation_aborted ? "closed" : ec.message());
+    if (ec) return on_error(ec, "disconnected");
     owner_.bytes_sent(n);
     do_write();
   });
+}
+
+void Session::on_error(const boost::system::error_code& ec, const char* on_eof) {
+  if (ec == asio::error::operation_aborted) return;  // we closed the socket ourselves: not an error
+  close(ec == asio::error::eof ? on_eof : ec.message());
 }
 
 void Session::close(const std::string& reason) {

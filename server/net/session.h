@@ -54,6 +54,8 @@ class Session : public std::enable_shared_from_this<Session> {
   void do_read_body(std::uint32_t body_bytes);
   void carry_out(Outcome outcome);
   void do_write();
+  // A failed read or write: the peer left, or the socket broke.
+  void on_error(const boost::system::error_code& ec, const char* on_eof);
 
   boost::asio::ip::tcp::socket socket_;
   std::uint32_t id_;
