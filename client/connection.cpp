@@ -1,6 +1,7 @@
 #include "client/connection.h"
 
 #include <algorithm>
+#include <cstdlib>
 
 #include "protocol/quantize.h"
 
@@ -106,12 +107,17 @@ void Connection::handle(const wire::Message& message) {
       view_.sim_time = s.sim_time();
       view_.ball_count = s.ball_count();
       const std::size_t common = std::min<std::size_t>(view_.positions.size(), s.positions()->size()) / 3;
-      std::size_t at_rest = 0;
-      for (std::size_t b = 0; b < common; ++b)
-        at_rest += view_.positions[3 * b] == s.positions()->Get(3 * b) &&
-                   view_.positions[3 * b + 1] == s.positions()->Get(3 * b + 1) &&
-                   view_.positions[3 * b + 2] == s.positions()->Get(3 * b + 2);
+      std::size_t at_rest = 0, small = 0;
+      for (std::size_t b = 0; b < common; ++b) {
+        int largest = 0;
+        for (std::size_t axis = 0; axis < 3; ++axis)
+          largest =
+              std::max(largest, std::abs(int{s.positions()->Get(3 * b + axis)} - int{view_.positions[3 * b + axis]}));
+        at_rest += largest == 0;
+        small += largest <= 127;
+      }
       stats_.at_rest_fraction = common ? static_cast<double>(at_rest) / common : 0.0;
+      stats_.int8_delta_fraction = common ? static_cast<double>(small) / common : 0.0;
       view_.positions.assign(s.positions()->begin(), s.positions()->end());
       view_.player_ids.clear();
       view_.player_positions.clear();

@@ -26,6 +26,9 @@ struct ConnectionStats {
   // Of the balls in both of the last two snapshots, the fraction whose quantised
   // position did not change: what an at-rest (delta) encoding could leave out.
   double at_rest_fraction = 0.0;
+  // ... and the fraction that moved at most 127 quanta on every axis: what a
+  // delta encoding could send in 3 bytes instead of 6.
+  double int8_delta_fraction = 0.0;
   std::optional<std::chrono::steady_clock::time_point> first_snapshot, last_snapshot;
 };
 

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
                         {"rtt_ms", s.rtt_ms},
                         {"balls", s.balls},
                         {"at_rest_fraction", s.at_rest_fraction},
+                        {"int8_delta_fraction", s.int8_delta_fraction},
                         {"errors", s.error_messages.size()},
                         {"error_messages", s.error_messages}};
     std::cout << j.dump() << std::endl;

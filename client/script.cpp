@@ -39,6 +39,7 @@ Summary summarise(const std::vector<std::shared_ptr<Connection>>& connections, d
       newest_tick = c->view().tick;
       s.balls = c->view().ball_count;
       s.at_rest_fraction = st.at_rest_fraction;
+      s.int8_delta_fraction = st.int8_delta_fraction;
     }
     if (!c->welcomed() && !c->close_reason().empty()) s.error_messages.push_back("connection: " + c->close_reason());
   }

@@ -27,12 +27,13 @@ struct Script {
 struct Summary {
   int clients = 0;
   int welcomed = 0;
-  std::uint64_t snapshots = 0;    // total over all clients
-  double snapshot_rate_hz = 0.0;  // mean per client
-  double bytes_per_s = 0.0;       // mean per client
-  double rtt_ms = 0.0;            // median over every Pong; 0 without any
-  std::uint32_t balls = 0;        // newest ball count seen
-  double at_rest_fraction = 0.0;  // in that newest snapshot (ConnectionStats::at_rest_fraction)
+  std::uint64_t snapshots = 0;       // total over all clients
+  double snapshot_rate_hz = 0.0;     // mean per client
+  double bytes_per_s = 0.0;          // mean per client
+  double rtt_ms = 0.0;               // median over every Pong; 0 without any
+  std::uint32_t balls = 0;           // newest ball count seen
+  double at_rest_fraction = 0.0;     // in that newest snapshot (ConnectionStats::at_rest_fraction)
+  double int8_delta_fraction = 0.0;  // likewise (ConnectionStats::int8_delta_fraction)
   std::vector<std::string> error_messages;
   std::string connect_error;  // non-empty when no connection could be made
 };
