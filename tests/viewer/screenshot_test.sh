@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The viewer for real (DESIGN "Tests"): a server on an ephemeral loopback
 # port, the viewer under Xvfb with Mesa's software OpenGL rendering frames and
-# saving a PNG, then the pixel check. Exit 77 (skipped) only without xvfb-run.
+# saving a PNG once the poured balls have settled, then the pixel check.
+# Exit 77 (skipped) only without xvfb-run.
 #
 # Usage: screenshot_test.sh SERVER VIEWER CHECKER OUT_DIR
 set -euo pipefail
@@ -29,6 +30,26 @@ for _ in $(seq 200); do
 done
 if [ -z "$port" ]; then
   echo "the server did not report its port:"
+  cat "$log"
+  exit 1
+fi
+
+# Wait until every ball has been poured in and has had 4 s of server time to
+# fall (the server's status lines give both), so the pile lies below the
+# player sphere at the tank's centre and no falling ball hides it.
+settled=""
+for _ in $(seq 1200); do
+  poured=$(sed -n 's/^t = *\([0-9.]*\) s *balls *[0-9]* (+0 queued).*/\1/p' "$log" | head -n 1)
+  latest=$(sed -n 's/^t = *\([0-9.]*\) s.*/\1/p' "$log" | tail -n 1)
+  if [ -n "$poured" ] && awk -v p="$poured" -v t="$latest" 'BEGIN { exit !(t >= p + 4) }'; then
+    settled=1
+    break
+  fi
+  kill -0 "$server_pid" 2>/dev/null || break
+  sleep 0.1
+done
+if [ -z "$settled" ]; then
+  echo "the server did not finish pouring its balls within 120 s:"
   cat "$log"
   exit 1
 fi
