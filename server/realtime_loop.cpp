@@ -45,6 +45,7 @@ void run_realtime(World& world, const LoopOptions& options, const std::atomic<bo
       if (options.on_status) options.on_status(world, status);
       window_start = busy_end;
       window_steps = 0;
+      status.dropped_steps = 0;
       window_busy = 0.0;
     }
     const double next_due = sim_clock + dt;
