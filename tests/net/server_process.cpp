@@ -37,7 +37,10 @@ ServerProcess::ServerProcess(const std::vector<std::string>& args) {
   log_path_ = (std::filesystem::temp_directory_path() /
                ("fishtank-net-test-" + std::to_string(getpid()) + "-" + std::to_string(counter++) + ".log"))
                   .string();
-  std::vector<std::string> argv_text{FISHTANK_SERVER_PATH, "--bind", "127.0.0.1", "--port", "0", "--threads", "1"};
+  // --duration: a server whose test was killed before its destructor ran still
+  // stops by itself instead of running on as an orphan.
+  std::vector<std::string> argv_text{FISHTANK_SERVER_PATH, "--bind", "127.0.0.1", "--port", "0",
+                                     "--threads",          "1",      "--duration", "300"};
   argv_text.insert(argv_text.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (std::string& a : argv_text) argv.push_back(a.data());
