@@ -35,9 +35,11 @@ float kick_drift(const StepArrays& s, const ContactModel& m, std::uint32_t begin
 
 // Sum over ball i's neighbours of the spring-dashpot force, as (Fx, Fy, Fz, 0).
 inline F4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t i, F4 pi, F4 vi) {
-  const F4 xi = simd::broadcast<0>(pi), yi = simd::broadcast<1>(pi), zi = simd::broadcast<2>(pi);
-  const F4 ri = simd::broadcast<3>(pi);
-  const F4 vxi = simd::broadcast<0>(vi), vyi = simd::broadcast<1>(vi), vzi = simd::broadcast<2>(vi);
+  // Differences are taken on whole rows before the transpose: pi - pos[j] is
+  // (dx, dy, dz, ri - rj) and vi - vel[j] is (dvx, dvy, dvz, mi - mj). That
+  // keeps only pi, vi and two broadcasts live instead of eight, so SSE's 16
+  // registers hold the loop without spilling to the stack.
+  const F4 two_ri = simd::broadcast<3>(pi) + simd::broadcast<3>(pi);
   const F4 mi = simd::broadcast<3>(vi);
   const F4 k = F4::splat(m.k), damping = F4::splat(m.damping_factor);
   const F4 tiny = F4::splat(1e-12f);  // squared distance floor: coincident centres stay finite
@@ -47,21 +49,22 @@ inline F4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t 
   const std::uint32_t count = padded_neighbour_count(s.neighbour_count[i]);
   for (std::uint32_t n = 0; n < count; n += 4) {
     const std::uint32_t j0 = list[n], j1 = list[n + 1], j2 = list[n + 2], j3 = list[n + 3];
-    F4 xj, yj, zj, rj;
-    simd::transpose(F4::load(s.pos[j0]), F4::load(s.pos[j1]), F4::load(s.pos[j2]), F4::load(s.pos[j3]), xj, yj, zj, rj);
-    F4 dx = xi - xj, dy = yi - yj, dz = zi - zj;
+    F4 dx, dy, dz, ri_minus_rj;
+    simd::transpose(pi - F4::load(s.pos[j0]), pi - F4::load(s.pos[j1]), pi - F4::load(s.pos[j2]),
+                    pi - F4::load(s.pos[j3]), dx, dy, dz, ri_minus_rj);
     F4 d2 = dx * dx + dy * dy + dz * dz;
-    F4 reach = ri + rj;
+    F4 reach = two_ri - ri_minus_rj;  // ri + rj
     M4 touching = d2 < reach * reach;
     if (!simd::any(touching)) continue;
 
-    F4 vxj, vyj, vzj, mj;
-    simd::transpose(F4::load(s.vel_half[j0]), F4::load(s.vel_half[j1]), F4::load(s.vel_half[j2]),
-                    F4::load(s.vel_half[j3]), vxj, vyj, vzj, mj);
+    F4 dvx, dvy, dvz, mi_minus_mj;
+    simd::transpose(vi - F4::load(s.vel_half[j0]), vi - F4::load(s.vel_half[j1]), vi - F4::load(s.vel_half[j2]),
+                    vi - F4::load(s.vel_half[j3]), dvx, dvy, dvz, mi_minus_mj);
     F4 inv_dist = simd::rsqrt(max(d2, tiny));
     F4 dist = d2 * inv_dist;
     F4 nx = dx * inv_dist, ny = dy * inv_dist, nz = dz * inv_dist;
-    F4 v_n = (vxi - vxj) * nx + (vyi - vyj) * ny + (vzi - vzj) * nz;
+    F4 v_n = dvx * nx + dvy * ny + dvz * nz;
+    F4 mj = mi - mi_minus_mj;
     F4 m_eff = mi * mj * simd::reciprocal(mi + mj);
     F4 c = damping * m_eff * simd::rsqrt(m_eff);  // damping * sqrt(m_eff)
     F4 f = keep(touching, k * (reach - dist) - c * v_n);
