@@ -1,9 +1,8 @@
 #include "server/options.h"
 
+#include <boost/program_options.hpp>
 #include <cmath>
 #include <sstream>
-
-#include <boost/program_options.hpp>
 
 #include "server/bench/scenes.h"
 #include "server/physics/worker_pool.h"
@@ -19,14 +18,14 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   std::int64_t threads = threaded ? WorkerPool::hardware_threads() : 1, max_balls = 0, seed = 1;
   std::int64_t steps_per_contact = defaults.steps_per_contact;
   double settle_time = 0.0;
+  std::int64_t windows = o.bench_spec.windows;
 
   po::options_description general("General");
   general.add_options()("help,h", "print this help and exit")(
       "threads", po::value(&threads)->default_value(threads),
       threaded ? "worker threads (default: the cores available now)" : "worker threads (the scalar build uses 1)")(
       "seed", po::value(&seed)->default_value(seed), "random seed for spawning, >= 0")(
-      "balls", po::value(&balls),
-      "balls to pour in at start (default 1000; with --bench, 6000)")(
+      "balls", po::value(&balls), "balls to pour in at start (default 1000; with --bench, 6000)")(
       "max-balls", po::value(&max_balls)->default_value(0), "most balls the tank may hold (0: its capacity, ~6100)")(
       "duration", po::value(&o.duration)->default_value(0.0), "stop after this many seconds (0: run until Ctrl-C)")(
       "status-interval", po::value(&o.status_interval)->default_value(1.0), "seconds between status lines");
@@ -46,17 +45,17 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   network.add_options()("bind", po::value(&o.bind)->default_value(o.bind),
                         "address to listen on (127.0.0.1: this machine only; 0.0.0.0: every interface)")(
       "port", po::value(&port)->default_value(port), "TCP port (0: pick a free one and print it)")(
-      "snapshot-rate", po::value(&o.snapshot_rate)->default_value(o.snapshot_rate), "snapshots per second sent to clients")(
-      "max-players", po::value(&max_players)->default_value(max_players),
-      "player spheres at most; later clients observe");
+      "snapshot-rate", po::value(&o.snapshot_rate)->default_value(o.snapshot_rate),
+      "snapshots per second sent to clients")("max-players", po::value(&max_players)->default_value(max_players),
+                                              "player spheres at most; later clients observe");
 
   po::options_description physics("Physics");
   physics.add_options()("stiffness", po::value(&o.physics.stiffness)->default_value(defaults.stiffness, "20000"),
                         "contact spring constant k, N/m")(
       "restitution", po::value(&o.physics.restitution)->default_value(defaults.restitution, "0.6"),
-      "coefficient of restitution e, (0, 1]")(
-      "steps-per-contact", po::value(&steps_per_contact)->default_value(steps_per_contact),
-      "automatic dt = contact duration / this (>= 10)")(
+      "coefficient of restitution e, (0, 1]")("steps-per-contact",
+                                              po::value(&steps_per_contact)->default_value(steps_per_contact),
+                                              "automatic dt = contact duration / this (>= 10)")(
       "dt", po::value(&o.physics.dt)->default_value(0.0), "fixed time step in seconds (0: automatic)")(
       "skin", po::value(&o.physics.skin)->default_value(defaults.skin, "0.3"), "neighbour-list skin, units");
 
@@ -64,6 +63,8 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   bench.add_options()("bench", po::bool_switch(&o.bench), "run unpaced without network and print one JSON object")(
       "scene", po::value(&o.bench_spec.scene.name)->default_value("tank"), "benchmark scene: tank or wide")(
       "steps", po::value(&steps)->default_value(steps), "timed steps after settling")(
+      "windows", po::value(&windows)->default_value(windows),
+      "the timed steps are split into this many windows; rates are their median")(
       "settle-time", po::value(&settle_time)->default_value(0.0),
       "most simulated seconds to wait for rest (0: 90 for tank, 4 for wide)");
 
@@ -96,11 +97,17 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
     return result;
   };
   if (balls == -1) balls = o.bench ? 6000 : start_balls;
-  if (balls < 0 || balls > 10'000'000) return fail("--balls must be between 0 and 10000000, got " + std::to_string(balls));
-  if (threads < 1 || threads > 1024) return fail("--threads must be between 1 and 1024, got " + std::to_string(threads));
-  if (!threaded && threads != 1) return fail("the scalar build runs on one thread; drop --threads or use fishtank-server");
+  if (balls < 0 || balls > 10'000'000)
+    return fail("--balls must be between 0 and 10000000, got " + std::to_string(balls));
+  if (threads < 1 || threads > 1024)
+    return fail("--threads must be between 1 and 1024, got " + std::to_string(threads));
+  if (!threaded && threads != 1)
+    return fail("the scalar build runs on one thread; drop --threads or use fishtank-server");
   if (seed < 0) return fail("--seed must be >= 0");
-  if (steps < 1 || steps > 1'000'000'000) return fail("--steps must be between 1 and 1e9, got " + std::to_string(steps));
+  if (steps < 1 || steps > 1'000'000'000)
+    return fail("--steps must be between 1 and 1e9, got " + std::to_string(steps));
+  if (windows < 1 || windows > 1000 || windows > steps)
+    return fail("--windows must be between 1 and 1000 and at most --steps, got " + std::to_string(windows));
   if (lammps_steps < 0 || lammps_steps > 1'000'000'000'000)
     return fail("--lammps-steps must be between 0 and 1e12, got " + std::to_string(lammps_steps));
   if (record_every < 1 || record_every > 1'000'000'000)
@@ -136,6 +143,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   o.bench_spec.scene.seed = static_cast<std::uint64_t>(seed);
   o.bench_spec.scene.max_settle_seconds = settle_time;
   o.bench_spec.steps = static_cast<std::uint64_t>(steps);
+  o.bench_spec.windows = static_cast<std::uint32_t>(windows);
   if (o.bench) o.physics.tank = scene_tank(o.bench_spec.scene);
   if (std::string why = validate(o.physics); !why.empty()) return fail(why);
   result.options = o;

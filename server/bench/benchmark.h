@@ -14,6 +14,7 @@ namespace fishtank {
 struct BenchSpec {
   SceneSpec scene;
   std::uint64_t steps = 2000;
+  std::uint32_t windows = 5;  // the timed steps are split into this many windows; rates are their median
 };
 
 // Runs the timed part on an already settled world and returns the report.
