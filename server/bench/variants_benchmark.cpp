@@ -1,0 +1,67 @@
+// Google Benchmark of whole physics steps for every kernel set on one settled
+// tank, so the variants' ratios come from one process and one state.
+//
+// A shared virtual machine's speed drifts by tens of percent over minutes.
+// Run with random interleaving and repetitions (as scripts/bench-kernels does)
+// so every variant samples the same drift, and compare medians.
+
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <functional>
+#include <vector>
+
+#include "common/fp_env.h"
+#include "server/bench/scenes.h"
+#include "server/physics/world.h"
+
+namespace {
+
+using fishtank::World;
+
+// The settled 6000-ball tank every benchmark starts from, made once.
+const std::vector<fishtank::BallView>& settled_tank() {
+  static const std::vector<fishtank::BallView> balls = [] {
+    fishtank::SceneSpec spec;  // tank, 6000 balls
+    World world(fishtank::PhysicsParams{}, fishtank::kSseKernels, fishtank::WorkerPool::hardware_threads(), 1);
+    fishtank::populate(world, spec);
+    fishtank::settle(world, spec);
+    std::vector<fishtank::BallView> state;
+    for (std::uint32_t id = 0; id < world.ball_count(); ++id) state.push_back(world.ball(id));
+    return state;
+  }();
+  return balls;
+}
+
+void step_tank(benchmark::State& state, const fishtank::Kernels& kernels) {
+  fishtank::enable_flush_denormals_to_zero();
+  const int threads = static_cast<int>(state.range(0));
+  World world(fishtank::PhysicsParams{}, kernels, threads, 1);
+  for (const fishtank::BallView& b : settled_tank())
+    world.place_ball(b.kind, {b.pos.x, b.pos.y, b.pos.z}, {b.vel.x, b.vel.y, b.vel.z});
+  for (int s = 0; s < 50; ++s) world.step();  // first lists, warm caches
+  for (auto _ : state) world.step();
+  state.counters["ball_steps_per_s"] =
+      benchmark::Counter(double(state.iterations()) * world.ball_count(), benchmark::Counter::kIsRate);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int cores = fishtank::WorkerPool::hardware_threads();
+  auto add = [cores](const char* name, const fishtank::Kernels& kernels, bool threaded) {
+    auto* b = benchmark::RegisterBenchmark(name, step_tank, std::cref(kernels));
+    b->Arg(1)->Unit(benchmark::kMicrosecond)->MinTime(0.5);
+    if (threaded && cores > 1) b->Arg(cores);
+  };
+  add("step_tank/scalar", fishtank::kScalarKernels, false);
+  add("step_tank/sse", fishtank::kSseKernels, true);
+  if (fishtank::cpu_has_avx2()) add("step_tank/avx2", fishtank::kAvx2Kernels, true);
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  std::fprintf(stderr, "settling the 6000-ball tank every benchmark starts from...\n");
+  settled_tank();
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
