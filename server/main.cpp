@@ -1,6 +1,7 @@
 // fishtank-server: flags and wiring only. The variant (scalar or SSE) is fixed
 // at compile time by FISHTANK_SIMD; both executables come from this file.
 
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <iostream>
@@ -107,6 +108,7 @@ int run_server(const fishtank::ServerOptions& o) {
   fishtank::LoopOptions loop;
   loop.duration = o.duration;
   loop.status_interval = o.status_interval;
+  loop.batch_seconds = std::min(0.004, 1.0 / o.snapshot_rate);  // 4 ms, or one snapshot interval if shorter
   loop.at_step_boundary = [&](fishtank::World& w, const fishtank::LoopStatus& s) {
     network.at_step_boundary(w, s);
     if (o.record_path.empty() || w.steps() < next_frame) return;

@@ -10,7 +10,6 @@ using Clock = std::chrono::steady_clock;
 // Past this much lag the loop stops trying to catch up and runs in slow motion
 // instead, rather than stalling everything in a burst of catch-up steps.
 constexpr double kMaxLagSeconds = 0.25;
-constexpr double kBatchSeconds = 0.004;
 }  // namespace
 
 void run_realtime(World& world, const LoopOptions& options, const std::atomic<bool>& stop) {
@@ -51,9 +50,8 @@ void run_realtime(World& world, const LoopOptions& options, const std::atomic<bo
     }
     // Sleep until a batch of steps is due rather than a single one: waking the
     // worker threads costs tens of microseconds on a virtual machine, paid
-    // once per batch instead of once per step (4 ms is a quarter of a 60 Hz
-    // snapshot interval, so viewers see no difference).
-    const double next_batch = sim_clock + std::max(dt, kBatchSeconds);
+    // once per batch instead of once per step.
+    const double next_batch = sim_clock + std::max(dt, options.batch_seconds);
     const double wait = next_batch - std::chrono::duration<double>(Clock::now() - start).count();
     if (wait > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
   }

@@ -12,13 +12,17 @@ namespace fishtank {
 
 struct LoopStatus {
   double steps_per_s = 0.0;
-  double load = 0.0;            // 0..1: time spent stepping / wall time
+  double load = 0.0;                // 0..1: time spent stepping / wall time
   std::uint64_t dropped_steps = 0;  // steps skipped because the machine fell behind, in the last interval
 };
 
 struct LoopOptions {
   double duration = 0.0;  // seconds; 0 runs until stop is set
   double status_interval = 1.0;
+  // Steps run in batches this long at most: waking the worker threads is paid
+  // once per batch, and at_step_boundary runs once per batch (so a batch must
+  // not be longer than the interval between snapshots).
+  double batch_seconds = 0.004;
   // Called on the loop's thread between steps, once per status interval.
   std::function<void(const World&, const LoopStatus&)> on_status;
   // Called on the loop's thread at every step boundary where the loop wakes
