@@ -1,13 +1,13 @@
 // fishtank-server: flags and wiring only. The variant (scalar or SSE) is fixed
 // at compile time by FISHTANK_SIMD; both executables come from this file.
 
+#include <spdlog/sinks/stdout_sinks.h>
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <iostream>
-
-#include <spdlog/sinks/stdout_sinks.h>
-#include <spdlog/spdlog.h>
 
 #include "common/fp_env.h"
 #include "server/bench/benchmark.h"
@@ -35,11 +35,17 @@ const fishtank::Kernels& kKernels = fishtank::kScalarKernels;
 // Set by SIGINT/SIGTERM (the network service's signal_set) to end the realtime loop.
 std::atomic<bool> g_stop{false};
 
-// The final-state files asked for on the command line.
+// The final-state files asked for on the command line. A benchmark records no
+// trajectory while it is timed, so --record there writes the final state only.
 int write_final_state(const fishtank::World& world, const fishtank::ServerOptions& o) {
   std::string err;
   if (!o.dump_path.empty()) err = fishtank::write_csv_dump(world, o.dump_path);
   if (err.empty() && !o.lammps_dir.empty()) err = fishtank::export_lammps(world, o.lammps_dir, o.lammps_steps);
+  if (err.empty() && o.bench && !o.record_path.empty()) {
+    fishtank::LammpsDumpWriter recorder;
+    err = recorder.open(o.record_path);
+    if (err.empty()) err = recorder.write_frame(world);
+  }
   if (err.empty()) return 0;
   std::cerr << "fishtank-server: " << err << "\n";
   return 1;
@@ -132,8 +138,7 @@ int main(int argc, char** argv) {
     std::cerr << "fishtank-server-avx2: this processor has no AVX2; use fishtank-server (SSE4.1) instead\n";
     return 1;
   }
-  fishtank::ParseResult parsed =
-      fishtank::parse_server_options(argc, argv, kKernels.variant, kKernels.threaded);
+  fishtank::ParseResult parsed = fishtank::parse_server_options(argc, argv, kKernels.variant, kKernels.threaded);
   if (!parsed.options) {
     (parsed.exit_code == 0 ? std::cout : std::cerr) << parsed.message << "\n";
     return parsed.exit_code;

@@ -37,7 +37,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "write DIR/data.fishtank and DIR/in.fishtank: the final state and contact model for LAMMPS")(
       "lammps-steps", po::value(&lammps_steps)->default_value(lammps_steps), "steps the exported LAMMPS script runs")(
       "record", po::value(&o.record_path),
-      "trajectory in LAMMPS dump format (OVITO, ASE, LAMMPS), while the server runs")(
+      "trajectory in LAMMPS dump format (OVITO, ASE, LAMMPS) while the server runs; with --bench, the final state")(
       "record-every", po::value(&record_every)->default_value(record_every), "steps between recorded frames");
 
   std::int64_t port = o.port, max_players = o.max_players;
@@ -112,8 +112,6 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
     return fail("--lammps-steps must be between 0 and 1e12, got " + std::to_string(lammps_steps));
   if (record_every < 1 || record_every > 1'000'000'000)
     return fail("--record-every must be between 1 and 1e9 steps, got " + std::to_string(record_every));
-  if (o.bench && !o.record_path.empty())
-    return fail("--record records a running server; with --bench use --dump or --export-lammps for the final state");
   o.lammps_steps = static_cast<std::uint64_t>(lammps_steps);
   o.record_every = static_cast<std::uint32_t>(record_every);
   if (max_balls < 0 || max_balls > 10'000'000) return fail("--max-balls must be between 0 and 10000000");
