@@ -71,13 +71,16 @@ TEST_CASE("every message survives encode then decode with its values intact", "[
   }
   SECTION("BallKinds, AddBalls, Ping, Pong, Error") {
     const std::uint8_t kinds[] = {0, 1, 2, 1};
-    auto k = decode(protocol::encode_ball_kinds(10, kinds, 4), Direction::to_client);
+    // A decoded message points into its frame, so the frames outlive the checks.
+    const protocol::Frame kinds_frame = protocol::encode_ball_kinds(10, kinds, 4);
+    auto k = decode(kinds_frame, Direction::to_client);
     REQUIRE(k.ok());
     CHECK(k.message->payload_as_BallKinds()->kinds()->Get(2) == 2);
     CHECK(decode(protocol::encode_add_balls(1000), Direction::to_server).ok());
     CHECK(decode(protocol::encode_ping(42), Direction::to_server).ok());
     CHECK(decode(protocol::encode_pong(42), Direction::to_client).message->payload_as_Pong()->client_time_us() == 42);
-    auto e = decode(protocol::encode_error(wire::ErrorCode::tank_full, "full"), Direction::to_client);
+    const protocol::Frame error_frame = protocol::encode_error(wire::ErrorCode::tank_full, "full");
+    auto e = decode(error_frame, Direction::to_client);
     REQUIRE(e.ok());
     CHECK(e.message->payload_as_Error()->code() == wire::ErrorCode::tank_full);
   }

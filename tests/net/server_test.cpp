@@ -304,8 +304,14 @@ TEST_CASE("clients that never read: the server's memory stays bounded and others
   const double rate = measure_rates(clients, {watcher}, 3.0).front();
   const long rss_end = server.rss_kb();
   INFO("server RSS " << rss_start << " kB -> " << rss_end << " kB");
+#if defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer keeps freed blocks in quarantine (256 MB by default), so
+  // the server's RSS grows with every freed snapshot; the Release run checks it.
+  WARN("AddressSanitizer build: RSS not meaningful (" << rss_end - rss_start << " kB growth)");
+#else
   CHECK(rss_end - rss_start < 8 * 1024);  // unbounded queues would add ~50 MB here
-  CHECK(rate > 300.0);                    // 400 Hz asked
+#endif
+  CHECK(rate > 300.0);  // 400 Hz asked
   CHECK(server.running());
   CHECK(watcher->stats().errors.empty());
 }
