@@ -42,7 +42,6 @@ inline F4 reciprocal(F4 a) {
   return {_mm_mul_ps(r, _mm_sub_ps(_mm_set1_ps(2.0f), _mm_mul_ps(a.v, r)))};
 }
 inline F4 max(F4 a, F4 b) { return {_mm_max_ps(a.v, b.v)}; }
-inline F4 min(F4 a, F4 b) { return {_mm_min_ps(a.v, b.v)}; }
 inline M4 operator<(F4 a, F4 b) { return {_mm_cmplt_ps(a.v, b.v)}; }
 inline M4 operator>(F4 a, F4 b) { return {_mm_cmpgt_ps(a.v, b.v)}; }
 inline M4 operator|(M4 a, M4 b) { return {_mm_or_ps(a.v, b.v)}; }

@@ -22,9 +22,9 @@ std::vector<std::uint32_t> indices_by_id(const World& world) {
   return by_id;
 }
 
-bool write_box(std::FILE* f, const TankBounds& t, const char* format) {
-  return std::fprintf(f, format, t.min.x - kBoxMargin, t.max.x + kBoxMargin, t.min.y - kBoxMargin, t.max.y + kBoxMargin,
-                      t.min.z - kBoxMargin, t.max.z + kBoxMargin) > 0;
+void write_box(std::FILE* f, const TankBounds& t, const char* format) {
+  std::fprintf(f, format, t.min.x - kBoxMargin, t.max.x + kBoxMargin, t.min.y - kBoxMargin, t.max.y + kBoxMargin,
+               t.min.z - kBoxMargin, t.max.z + kBoxMargin);
 }
 
 std::string write_data(const World& world, const std::string& path) {

@@ -39,7 +39,6 @@ class NeighbourList {
   std::uint32_t stride() const { return stride_; }
   const std::uint32_t* neighbours() const { return neighbours_.data(); }
   const std::uint32_t* counts() const { return counts_.data(); }
-  float skin() const { return skin_; }
 
  private:
   std::uint32_t cell_of(const Float4& p) const;

@@ -304,7 +304,7 @@ float World::max_overlap_fraction() const {
   const TankBounds& t = params_.tank;
   for (std::uint32_t i = 0; i < n_; ++i) {
     const Float4& p = pos_[i];
-    // Pairs are found by brute force over the neighbour list, which holds every touching pair.
+    // The neighbour list holds every touching pair (stale only between a spawn and the next step).
     if (!needs_rebuild_) {
       const std::uint32_t* list = list_.neighbours() + std::size_t(i) * list_.stride();
       for (std::uint32_t n = 0; n < list_.counts()[i]; ++n) {
