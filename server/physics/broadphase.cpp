@@ -52,7 +52,7 @@ void NeighbourList::sort(const Float4* pos, std::uint32_t n, std::vector<std::ui
 }
 
 void NeighbourList::reserve(std::uint32_t n, std::uint32_t stride) {
-  stride_ = padded_neighbour_count(std::max(stride, 4u));
+  stride_ = padded_neighbour_count(std::max(stride, kListPadding), kListPadding);
   neighbours_.resize(std::size_t(n) * stride_);
   counts_.resize(n);
 }
@@ -82,7 +82,8 @@ std::uint32_t NeighbourList::build(const Float4* pos, std::uint32_t n, std::uint
       }
     }
     counts_[i] = count;
-    for (std::uint32_t pad = count; pad < std::min(padded_neighbour_count(count), stride_); ++pad) list[pad] = ghost;
+    for (std::uint32_t pad = count; pad < std::min(padded_neighbour_count(count, kListPadding), stride_); ++pad)
+      list[pad] = ghost;
     longest = std::max(longest, count);
   }
   return longest;

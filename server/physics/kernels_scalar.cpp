@@ -100,6 +100,6 @@ void forces_kick(const StepArrays& s, const ContactModel& m, std::uint32_t begin
 
 }  // namespace
 
-const Kernels kScalarKernels{"scalar", "none", false, kick_drift, forces_kick};
+const Kernels kScalarKernels{"scalar", "none", 1, false, kick_drift, forces_kick};
 
 }  // namespace fishtank

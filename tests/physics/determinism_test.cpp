@@ -11,12 +11,12 @@ using namespace fishtank;
 
 namespace {
 
-std::uint64_t run(int threads) {
+std::uint64_t run(const Kernels& kernels, int threads) {
   // 5000 balls, so that even 4 threads each get a chunk worth splitting off.
   PhysicsParams params;
   params.tank.min = {-40.0f, 0.0f, -40.0f};
   params.tank.max = {40.0f, 40.0f, 40.0f};
-  World world(params, kSseKernels, threads, 99);
+  World world(params, kernels, threads, 99);
   for (int b = 0; b < 5000; ++b) {
     Vec3 p{-39.0f + 3.05f * (b % 26), 1.6f + 3.05f * (b / 676), -39.0f + 3.05f * ((b / 26) % 26)};
     world.place_ball(b % kKindCount, p, Vec3{0.1f * (b % 7) - 0.3f, 0.0f, 0.1f * (b % 5) - 0.2f});
@@ -35,7 +35,15 @@ std::uint64_t run(int threads) {
 }  // namespace
 
 TEST_CASE("state is bit-identical for 1, 2 and 4 threads", "[physics][determinism]") {
-  const std::uint64_t one = run(1);
-  CHECK(run(2) == one);
-  CHECK(run(4) == one);
+  const std::uint64_t one = run(kSseKernels, 1);
+  CHECK(run(kSseKernels, 2) == one);
+  CHECK(run(kSseKernels, 4) == one);
+}
+
+TEST_CASE("the AVX2 level's state is bit-identical for 1 and 2 threads", "[physics][determinism]") {
+  if (!cpu_has_avx2()) {
+    WARN("this processor has no AVX2; nothing to compare");
+    return;
+  }
+  CHECK(run(kAvx2Kernels, 2) == run(kAvx2Kernels, 1));
 }

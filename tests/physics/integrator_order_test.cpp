@@ -7,6 +7,7 @@
 #include "tests/physics/scenarios.h"
 
 using namespace fishtank;
+using namespace fishtank::test;
 
 namespace {
 
@@ -35,7 +36,7 @@ double oscillation_error(const Kernels& kernels, float dt, float duration) {
 }  // namespace
 
 TEST_CASE("velocity Verlet error falls ~4x when dt halves (second order)", "[physics][convergence]") {
-  const Kernels& kernels = GENERATE(std::cref(kScalarKernels), std::cref(kSseKernels));
+  const Kernels& kernels = kernels_named(GENERATE(from_range(variant_names())));
   const float duration = 0.1f;         // a little over two periods
   const float dt = duration / 200.0f;  // 0.5 ms, below the default 0.79 ms
   const double e1 = oscillation_error(kernels, dt, duration);

@@ -4,13 +4,22 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "server/physics/world.h"
 
 namespace fishtank::test {
 
-// Both kernel twins, for tests that must hold for each.
-inline const Kernels& kernels_named(const std::string& name) { return name == "sse" ? kSseKernels : kScalarKernels; }
+// Every kernel set this processor runs, for tests that must hold for each.
+inline std::vector<std::string> variant_names() {
+  std::vector<std::string> names{"scalar", "sse"};
+  if (cpu_has_avx2()) names.push_back("avx2");
+  return names;
+}
+inline const Kernels& kernels_named(const std::string& name) {
+  if (name == "avx2") return kAvx2Kernels;
+  return name == "sse" ? kSseKernels : kScalarKernels;
+}
 
 // No gravity, in a tank wide enough that nothing reaches a wall by accident.
 inline PhysicsParams open_space() {

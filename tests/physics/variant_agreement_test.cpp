@@ -12,15 +12,19 @@
 using namespace fishtank;
 using namespace fishtank::test;
 
-TEST_CASE("scalar and SSE trajectories agree over a short horizon", "[physics][variants]") {
-  // Both twins start from the same settled pile, stirred by a player sphere,
-  // so nearly every ball has several contacts throughout.
+namespace {
+
+// Largest position difference from the scalar twin after 500 steps (0.4 s) of
+// a settled 1000-ball pile stirred by a player sphere, so nearly every ball
+// has several contacts throughout. Differences then grow chaotically
+// (3.5e-4 at 1000 steps).
+float short_horizon_difference(const Kernels& kernels) {
   World pile(PhysicsParams{}, kSseKernels, 2, 1);
   pour_and_settle(pile, 1000, 40.0);
   REQUIRE(pile.mean_neighbours() > 5.0);
   World scalar(PhysicsParams{}, kScalarKernels, 1, 1);
-  World sse(PhysicsParams{}, kSseKernels, 2, 1);
-  for (World* w : {&scalar, &sse}) {
+  World simd(PhysicsParams{}, kernels, 2, 1);
+  for (World* w : {&scalar, &simd}) {
     for (std::uint32_t id = 0; id < pile.ball_count(); ++id) {
       BallView b = pile.ball(id);
       w->place_ball(b.kind, {b.pos.x, b.pos.y, b.pos.z}, {b.vel.x, b.vel.y, b.vel.z});
@@ -28,17 +32,23 @@ TEST_CASE("scalar and SSE trajectories agree over a short horizon", "[physics][v
     const std::uint32_t player = w->add_player();
     w->set_player_velocity(player, {0.0f, -5.0f, 2.0f});
   }
-  const int steps = 500;  // 0.4 s; differences then grow chaotically (3.5e-4 at 1000 steps)
-  for (int s = 0; s < steps; ++s) {
+  for (int s = 0; s < 500; ++s) {
     scalar.step();
-    sse.step();
+    simd.step();
   }
   float worst = 0.0f;
   for (std::uint32_t id = 0; id < scalar.ball_count(); ++id) {
-    Float4 a = scalar.ball(id).pos, b = sse.ball(id).pos;
+    Float4 a = scalar.ball(id).pos, b = simd.ball(id).pos;
     worst = std::max({worst, std::fabs(a.x - b.x), std::fabs(a.y - b.y), std::fabs(a.z - b.z)});
   }
-  INFO("largest position difference after " << steps << " steps: " << worst);
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("scalar and SSE trajectories agree over a short horizon", "[physics][variants]") {
+  const float worst = short_horizon_difference(kSseKernels);
+  INFO("largest position difference after 500 steps: " << worst);
   CHECK(worst < 1e-3f);
 }
 
@@ -61,19 +71,14 @@ TEST_CASE("scalar and SSE settle into the same pile", "[physics][variants][slow]
   CHECK(scalar.max_overlap_fraction() == Approx(sse.max_overlap_fraction()).margin(0.03));
 }
 
-TEST_CASE("the AVX2 build of the SSE kernels computes bit-identical states", "[physics][variants]") {
+TEST_CASE("scalar and AVX2 trajectories agree over a short horizon", "[physics][variants]") {
   if (!cpu_has_avx2()) {
     WARN("this processor has no AVX2; nothing to compare");
     return;
   }
-  // Same source, same operations on the same lanes, no contraction into FMA:
-  // only the instruction encoding differs, so the states must match exactly.
-  World sse(PhysicsParams{}, kSseKernels, 2, 8);
-  World avx2(PhysicsParams{}, kAvx2Kernels, 2, 8);
-  for (World* w : {&sse, &avx2}) {
-    w->add_balls(1500);
-    w->set_player_velocity(w->add_player(), {2.0f, -3.0f, 1.0f});
-    for (int s = 0; s < 3000; ++s) w->step();
-  }
-  CHECK(avx2.state_hash() == sse.state_hash());
+  // Eight lanes and fused multiply-adds round differently from four lanes,
+  // so the AVX2 level is held to the same tolerance as SSE, not to its bits.
+  const float worst = short_horizon_difference(kAvx2Kernels);
+  INFO("largest position difference after 500 steps: " << worst);
+  CHECK(worst < 1e-3f);
 }

@@ -1,0 +1,74 @@
+#pragma once
+// Thin wrapper over 256-bit AVX/FMA intrinsics: eight float lanes (F8) and a
+// lane mask (M8), the wide sibling of sse_float4.h. Only the AVX2 kernels
+// include it. A 256-bit register is two 128-bit halves, and the in-lane
+// shuffles act on each half separately, so "rows" here are pairs of Float4
+// (one in each half) and a transpose yields lanes in the order
+// (row0.lo, row1.lo, row2.lo, row3.lo, row0.hi, row1.hi, row2.hi, row3.hi).
+
+#include <immintrin.h>
+
+#include "common/float4.h"
+#include "common/simd/sse_float4.h"
+
+namespace fishtank::simd {
+
+struct M8 {
+  __m256 v;
+};
+
+struct F8 {
+  __m256 v;
+
+  static F8 splat(float s) { return {_mm256_set1_ps(s)}; }
+  static F8 zero() { return {_mm256_setzero_ps()}; }
+  // The same four lanes in both halves.
+  static F8 both(F4 a) { return {_mm256_set_m128(a.v, a.v)}; }
+  // lo in the low half, hi in the high half: two aligned loads.
+  static F8 load_pair(const Float4& lo, const Float4& hi) {
+    return {_mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(&lo.x)), _mm_load_ps(&hi.x), 1)};
+  }
+};
+
+inline F8 operator+(F8 a, F8 b) { return {_mm256_add_ps(a.v, b.v)}; }
+inline F8 operator-(F8 a, F8 b) { return {_mm256_sub_ps(a.v, b.v)}; }
+inline F8 operator*(F8 a, F8 b) { return {_mm256_mul_ps(a.v, b.v)}; }
+// a * b + c in one rounding.
+inline F8 mul_add(F8 a, F8 b, F8 c) { return {_mm256_fmadd_ps(a.v, b.v, c.v)}; }
+// c - a * b in one rounding.
+inline F8 neg_mul_add(F8 a, F8 b, F8 c) { return {_mm256_fnmadd_ps(a.v, b.v, c.v)}; }
+// 1/sqrt(a) to about 1e-7 relative: the 12-bit estimate plus one Newton step.
+inline F8 rsqrt(F8 a) {
+  __m256 r = _mm256_rsqrt_ps(a.v);
+  __m256 half_a_r2 = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), a.v), _mm256_mul_ps(r, r));
+  return {_mm256_mul_ps(r, _mm256_sub_ps(_mm256_set1_ps(1.5f), half_a_r2))};
+}
+inline F8 max(F8 a, F8 b) { return {_mm256_max_ps(a.v, b.v)}; }
+inline M8 operator<(F8 a, F8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_LT_OQ)}; }
+inline bool any(M8 m) { return _mm256_movemask_ps(m.v) != 0; }
+// Lanes where the mask is off become zero.
+inline F8 keep(M8 m, F8 a) { return {_mm256_and_ps(m.v, a.v)}; }
+
+// Lane L of each half, broadcast across that half (the same value in both
+// halves when a came from F8::both).
+template <int L>
+inline F8 broadcast(F8 a) {
+  return {_mm256_shuffle_ps(a.v, a.v, _MM_SHUFFLE(L, L, L, L))};
+}
+
+// Four rows of two Float4 each become columns: xs, ys, zs, ws of the eight.
+inline void transpose(F8 a, F8 b, F8 c, F8 d, F8& xs, F8& ys, F8& zs, F8& ws) {
+  __m256 t0 = _mm256_unpacklo_ps(a.v, b.v);  // ax bx ay by, per half
+  __m256 t1 = _mm256_unpacklo_ps(c.v, d.v);  // cx dx cy dy
+  __m256 t2 = _mm256_unpackhi_ps(a.v, b.v);  // az bz aw bw
+  __m256 t3 = _mm256_unpackhi_ps(c.v, d.v);  // cz dz cw dw
+  xs.v = _mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(1, 0, 1, 0));
+  ys.v = _mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(3, 2, 3, 2));
+  zs.v = _mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(1, 0, 1, 0));
+  ws.v = _mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(3, 2, 3, 2));
+}
+
+// The two halves added: eight lanes folded into four.
+inline F4 fold_halves(F8 a) { return {_mm_add_ps(_mm256_castps256_ps128(a.v), _mm256_extractf128_ps(a.v, 1))}; }
+
+}  // namespace fishtank::simd

@@ -1,0 +1,92 @@
+#pragma once
+// The parts of the SIMD step kernels that work on one ball at a time in four
+// lanes: the kick-drift pass, walls, player spheres, and the force pass around
+// a neighbour loop that each kernel file supplies (4 lanes in kernels_sse.cpp,
+// 8 in kernels_avx2.cpp).
+//
+// Both files include this header and are compiled with different -m flags, so
+// everything here has internal linkage: each gets its own copy in its own
+// instruction set, and the linker can never hand AVX2 code to the SSE build.
+
+#include "common/simd/sse_float4.h"
+#include "server/physics/kernels.h"
+
+namespace fishtank {
+namespace {
+
+using simd::F4;
+using simd::M4;
+
+float kick_drift(const StepArrays& s, const ContactModel& m, std::uint32_t begin, std::uint32_t end) {
+  const F4 half_dt = F4::splat(m.half_dt);
+  const F4 dt_xyz = F4::set(m.dt, m.dt, m.dt, 0.0f);
+  F4 max_d2 = F4::zero();
+  for (std::uint32_t i = begin; i < end; ++i) {
+    F4 vh = F4::load(s.vel[i]) + F4::load(s.acc[i]) * half_dt;  // acc.w == 0 keeps the mass
+    F4 p = F4::load(s.pos[i]) + vh * dt_xyz;
+    vh.store(s.vel_half[i]);
+    p.store(s.pos[i]);
+    F4 d = p - F4::load(s.pos_at_build[i]);  // w lanes are both the radius
+    max_d2 = max(max_d2, dot3(d, d));
+  }
+  return simd::lane(max_d2, 0);
+}
+
+// Kinematic player spheres: the ball's effective mass is its own mass.
+inline F4 player_forces(const StepArrays& s, const ContactModel& m, F4 pi, F4 vi) {
+  F4 force = F4::zero();
+  const float ri = simd::lane(pi, 3);
+  const F4 c = F4::splat(m.damping_factor) * sqrt(simd::broadcast<3>(vi));
+  for (int p = 0; p < s.players; ++p) {
+    F4 d = simd::xyz_only(pi - F4::load(s.player_pos[p]));
+    float reach = ri + s.player_pos[p].w;
+    F4 d2 = dot3(d, d);
+    if (simd::lane(d2, 0) >= reach * reach) continue;
+    F4 dist = max(sqrt(d2), F4::splat(1e-6f));
+    F4 n = d / dist;
+    F4 v_n = dot3(vi - F4::load(s.player_vel[p]), n);
+    force += (F4::splat(m.k) * (F4::splat(reach) - dist) - c * v_n) * n;
+  }
+  return force;
+}
+
+// Six half-space walls, one lane per axis: below the minimum face the force
+// points +axis, above the maximum face -axis; both grow with depth. The w
+// lanes of the faces are chosen so the w lane never registers a contact.
+struct Walls {
+  F4 lo, hi;
+  explicit Walls(const TankBounds& t)
+      : lo(F4::set(t.min.x, t.min.y, t.min.z, -1e30f)), hi(F4::set(t.max.x, t.max.y, t.max.z, 1e30f)) {}
+};
+
+inline F4 wall_forces(const ContactModel& m, const Walls& walls, F4 pi, F4 vi) {
+  const F4 r = simd::broadcast<3>(pi);
+  const F4 below = walls.lo + r - pi;
+  const F4 above = pi + r - walls.hi;
+  const M4 in_floor_or_wall = below > F4::zero(), in_ceiling_or_wall = above > F4::zero();
+  if (!simd::any(in_floor_or_wall | in_ceiling_or_wall)) return F4::zero();  // most balls touch no wall
+  const F4 k = F4::splat(m.k);
+  const F4 c = F4::splat(m.damping_factor) * sqrt(simd::broadcast<3>(vi));
+  const F4 v = simd::xyz_only(vi);
+  return keep(in_floor_or_wall, k * below - c * v) - keep(in_ceiling_or_wall, k * above + c * v);
+}
+
+// PairForces(s, m, i, p_i, v_i) sums the spring-dashpot forces of ball i's neighbours as (Fx, Fy, Fz, 0).
+template <F4 (*PairForces)(const StepArrays&, const ContactModel&, std::uint32_t, F4, F4)>
+void forces_kick(const StepArrays& s, const ContactModel& m, std::uint32_t begin, std::uint32_t end) {
+  const F4 gravity = F4::set(0.0f, -m.gravity, 0.0f, 0.0f);
+  const F4 half_dt = F4::splat(m.half_dt);
+  const Walls walls(m.tank);
+  for (std::uint32_t i = begin; i < end; ++i) {
+    const F4 pi = F4::load(s.pos[i]);
+    const F4 vi = F4::load(s.vel_half[i]);
+    F4 force = PairForces(s, m, i, pi, vi) + wall_forces(m, walls, pi, vi);
+    if (s.players > 0) force += player_forces(s, m, pi, vi);
+    F4 a = force / simd::broadcast<3>(vi) + gravity;  // force.w == 0, so a.w == 0
+    a.store(s.acc[i]);
+    (vi + a * half_dt).store(s.vel[i]);
+  }
+}
+
+}  // namespace
+}  // namespace fishtank
