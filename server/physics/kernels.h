@@ -1,5 +1,5 @@
 #pragma once
-// The two hot passes of a step, each in two twins with the same signature:
+// The hot pass of a step, in twins with the same signature:
 //   kernels_scalar.cpp  plain C++, one pair at a time (the reference)
 //   kernels_sse.cpp     SSE4.1, four neighbours at a time
 //   kernels_avx2.cpp    AVX2 + FMA, eight neighbours at a time (a third level)
@@ -7,10 +7,13 @@
 // A build picks one set at compile time (see server/main.cpp); the tests hold
 // them all so they can compare them.
 //
-// Velocity Verlet, split so each pass writes only ball i and reads neighbours
-// only from arrays the pass does not write (no races, no atomics):
-//   kick_drift:   v_half = v + a dt/2;  x += v_half dt
-//   forces_kick:  a = F(x, v_half) / m + g;  v = v_half + a dt/2
+// Velocity Verlet in one pass over the balls per step. Positions and
+// half-step velocities are double-buffered: the pass reads this step's
+// (pos, vel_half) of ball i and its neighbours and writes only ball i's
+// outputs, so chunks run in parallel with no races and no atomics:
+//   a    = F(pos, vel_half) / m + g
+//   vel  = vel_half + a dt/2                 (the full step, what observers see)
+//   vel_half_next = vel + a dt/2,  pos_next = pos + vel_half_next dt
 
 #include <cstdint>
 
@@ -20,10 +23,11 @@
 namespace fishtank {
 
 struct StepArrays {
-  Float4* pos;       // x, y, z, radius
-  Float4* vel;       // vx, vy, vz, mass (velocity at the full step)
-  Float4* vel_half;  // vx, vy, vz, mass (velocity at the half step)
-  Float4* acc;       // ax, ay, az, 0
+  const Float4* pos;       // x, y, z, radius at this step
+  const Float4* vel_half;  // vx, vy, vz, mass: velocity half a step before
+  Float4* vel;             // out: vx, vy, vz, mass at this step
+  Float4* pos_next;        // out: position one step later
+  Float4* vel_half_next;   // out: velocity half a step later
   const Float4* pos_at_build;
   // Full neighbour list (each pair appears from both sides): ball i's
   // neighbours are neighbours[i * stride, i * stride + count[i]), followed by
@@ -37,13 +41,17 @@ struct StepArrays {
 };
 
 struct Kernels {
-  const char* variant;  // "scalar" or "sse"
+  const char* variant;  // "scalar", "sse" or "avx2"
   const char* simd;     // instruction set of the kernels
   int lanes;            // neighbours per SIMD block (1 for scalar)
   bool threaded;        // whether the build may use more than one thread
-  // Returns the largest squared displacement since the neighbour list was built.
-  float (*kick_drift)(const StepArrays& s, const ContactModel& m, std::uint32_t begin, std::uint32_t end);
-  void (*forces_kick)(const StepArrays& s, const ContactModel& m, std::uint32_t begin, std::uint32_t end);
+  // The step for balls [begin, end). Returns the largest squared distance of
+  // pos_next from pos_at_build, which tells when the lists must be rebuilt.
+  float (*step)(const StepArrays& s, const ContactModel& m, std::uint32_t begin, std::uint32_t end);
+  // a = F(pos, vel_half) / m + g only, into acc: for a state whose forces are
+  // not known yet (balls placed in contact). Writes none of s's outputs.
+  void (*accelerations)(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin,
+                        std::uint32_t end);
 };
 
 extern const Kernels kScalarKernels;

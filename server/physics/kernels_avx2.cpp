@@ -19,7 +19,8 @@ using simd::F8;
 using simd::M8;
 
 // Sum over ball i's neighbours of the spring-dashpot force, as (Fx, Fy, Fz, 0).
-inline F4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t i, F4 pi4, F4 vi4) {
+[[gnu::always_inline]] inline F4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t i, F4 pi4,
+                                             F4 vi4) {
   // As in the SSE kernel, rows are subtracted before the transpose:
   // pi - pos[j] is (dx, dy, dz, ri - rj), vi - vel[j] is (dvx, dvy, dvz, mi - mj).
   const F8 pi = F8::both(pi4), vi = F8::both(vi4);
@@ -65,6 +66,6 @@ inline F4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t 
 
 }  // namespace
 
-const Kernels kAvx2Kernels{"avx2", "avx2+fma", 8, true, kick_drift, forces_kick<pair_forces>};
+const Kernels kAvx2Kernels{"avx2", "avx2+fma", 8, true, step<pair_forces>, accelerations<pair_forces>};
 
 }  // namespace fishtank

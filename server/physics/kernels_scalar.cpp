@@ -8,27 +8,6 @@
 namespace fishtank {
 namespace {
 
-float kick_drift(const StepArrays& s, const ContactModel& m, std::uint32_t begin, std::uint32_t end) {
-  float max_d2 = 0.0f;
-  for (std::uint32_t i = begin; i < end; ++i) {
-    Float4& p = s.pos[i];
-    const Float4& v = s.vel[i];
-    const Float4& a = s.acc[i];
-    Float4& vh = s.vel_half[i];
-    vh.x = v.x + a.x * m.half_dt;
-    vh.y = v.y + a.y * m.half_dt;
-    vh.z = v.z + a.z * m.half_dt;
-    vh.w = v.w;
-    p.x += vh.x * m.dt;
-    p.y += vh.y * m.dt;
-    p.z += vh.z * m.dt;
-    const Float4& b = s.pos_at_build[i];
-    float dx = p.x - b.x, dy = p.y - b.y, dz = p.z - b.z;
-    max_d2 = std::max(max_d2, dx * dx + dy * dy + dz * dz);
-  }
-  return max_d2;
-}
-
 // Spring-dashpot force on a ball along unit normal n (pointing towards the
 // ball): k x - c v_n, with v_n the ball's velocity relative to the other body
 // projected on n, and c from the pair's effective mass.
@@ -46,60 +25,79 @@ inline float wall_force_1d(const ContactModel& m, float pos, float vel, float r,
   return f;
 }
 
-void forces_kick(const StepArrays& s, const ContactModel& m, std::uint32_t begin, std::uint32_t end) {
-  for (std::uint32_t i = begin; i < end; ++i) {
-    const Float4 pi = s.pos[i];
-    const Float4 vi = s.vel_half[i];
-    float fx = 0.0f, fy = 0.0f, fz = 0.0f;
+// a = F / m + g for ball i, from this step's positions and half-step velocities.
+// Inlined into the ball loops so the contact constants stay in registers.
+[[gnu::always_inline]] inline Float4 acceleration(const StepArrays& s, const ContactModel& m, std::uint32_t i) {
+  const Float4 pi = s.pos[i];
+  const Float4 vi = s.vel_half[i];
+  float fx = 0.0f, fy = 0.0f, fz = 0.0f;
 
-    const std::uint32_t* list = s.neighbours + std::size_t(i) * s.stride;
-    for (std::uint32_t n = 0; n < s.neighbour_count[i]; ++n) {
-      const Float4& pj = s.pos[list[n]];
-      float dx = pi.x - pj.x, dy = pi.y - pj.y, dz = pi.z - pj.z;
-      float d2 = dx * dx + dy * dy + dz * dz;
-      float reach = pi.w + pj.w;
-      if (d2 >= reach * reach) continue;
-      const Float4& vj = s.vel_half[list[n]];
-      float dist = std::max(std::sqrt(d2), 1e-6f);
-      float inv_dist = 1.0f / dist;
-      float nx = dx * inv_dist, ny = dy * inv_dist, nz = dz * inv_dist;
-      float v_n = (vi.x - vj.x) * nx + (vi.y - vj.y) * ny + (vi.z - vj.z) * nz;
-      float m_eff = vi.w * vj.w / (vi.w + vj.w);
-      float f = normal_force(m, reach - dist, v_n, m_eff);
-      fx += f * nx;
-      fy += f * ny;
-      fz += f * nz;
-    }
-
-    for (int p = 0; p < s.players; ++p) {
-      const Float4& pp = s.player_pos[p];
-      const Float4& pv = s.player_vel[p];
-      float dx = pi.x - pp.x, dy = pi.y - pp.y, dz = pi.z - pp.z;
-      float d2 = dx * dx + dy * dy + dz * dz;
-      float reach = pi.w + pp.w;
-      if (d2 >= reach * reach) continue;
-      float dist = std::max(std::sqrt(d2), 1e-6f);
-      float inv_dist = 1.0f / dist;
-      float nx = dx * inv_dist, ny = dy * inv_dist, nz = dz * inv_dist;
-      float v_n = (vi.x - pv.x) * nx + (vi.y - pv.y) * ny + (vi.z - pv.z) * nz;
-      float f = normal_force(m, reach - dist, v_n, vi.w);
-      fx += f * nx;
-      fy += f * ny;
-      fz += f * nz;
-    }
-
-    fx += wall_force_1d(m, pi.x, vi.x, pi.w, vi.w, m.tank.min.x, m.tank.max.x);
-    fy += wall_force_1d(m, pi.y, vi.y, pi.w, vi.w, m.tank.min.y, m.tank.max.y);
-    fz += wall_force_1d(m, pi.z, vi.z, pi.w, vi.w, m.tank.min.z, m.tank.max.z);
-
-    Float4 a{fx / vi.w, fy / vi.w - m.gravity, fz / vi.w, 0.0f};
-    s.acc[i] = a;
-    s.vel[i] = Float4{vi.x + a.x * m.half_dt, vi.y + a.y * m.half_dt, vi.z + a.z * m.half_dt, vi.w};
+  const std::uint32_t* list = s.neighbours + std::size_t(i) * s.stride;
+  for (std::uint32_t n = 0; n < s.neighbour_count[i]; ++n) {
+    const Float4& pj = s.pos[list[n]];
+    float dx = pi.x - pj.x, dy = pi.y - pj.y, dz = pi.z - pj.z;
+    float d2 = dx * dx + dy * dy + dz * dz;
+    float reach = pi.w + pj.w;
+    if (d2 >= reach * reach) continue;
+    const Float4& vj = s.vel_half[list[n]];
+    float dist = std::max(std::sqrt(d2), 1e-6f);
+    float inv_dist = 1.0f / dist;
+    float nx = dx * inv_dist, ny = dy * inv_dist, nz = dz * inv_dist;
+    float v_n = (vi.x - vj.x) * nx + (vi.y - vj.y) * ny + (vi.z - vj.z) * nz;
+    float m_eff = vi.w * vj.w / (vi.w + vj.w);
+    float f = normal_force(m, reach - dist, v_n, m_eff);
+    fx += f * nx;
+    fy += f * ny;
+    fz += f * nz;
   }
+
+  for (int p = 0; p < s.players; ++p) {
+    const Float4& pp = s.player_pos[p];
+    const Float4& pv = s.player_vel[p];
+    float dx = pi.x - pp.x, dy = pi.y - pp.y, dz = pi.z - pp.z;
+    float d2 = dx * dx + dy * dy + dz * dz;
+    float reach = pi.w + pp.w;
+    if (d2 >= reach * reach) continue;
+    float dist = std::max(std::sqrt(d2), 1e-6f);
+    float inv_dist = 1.0f / dist;
+    float nx = dx * inv_dist, ny = dy * inv_dist, nz = dz * inv_dist;
+    float v_n = (vi.x - pv.x) * nx + (vi.y - pv.y) * ny + (vi.z - pv.z) * nz;
+    float f = normal_force(m, reach - dist, v_n, vi.w);
+    fx += f * nx;
+    fy += f * ny;
+    fz += f * nz;
+  }
+
+  fx += wall_force_1d(m, pi.x, vi.x, pi.w, vi.w, m.tank.min.x, m.tank.max.x);
+  fy += wall_force_1d(m, pi.y, vi.y, pi.w, vi.w, m.tank.min.y, m.tank.max.y);
+  fz += wall_force_1d(m, pi.z, vi.z, pi.w, vi.w, m.tank.min.z, m.tank.max.z);
+  return Float4{fx / vi.w, fy / vi.w - m.gravity, fz / vi.w, 0.0f};
+}
+
+float step(const StepArrays& s, const ContactModel& m, std::uint32_t begin, std::uint32_t end) {
+  float max_d2 = 0.0f;
+  for (std::uint32_t i = begin; i < end; ++i) {
+    const Float4 a = acceleration(s, m, i);
+    const Float4 p = s.pos[i], vh = s.vel_half[i];
+    const Float4 v{vh.x + a.x * m.half_dt, vh.y + a.y * m.half_dt, vh.z + a.z * m.half_dt, vh.w};
+    const Float4 vh_next{v.x + a.x * m.half_dt, v.y + a.y * m.half_dt, v.z + a.z * m.half_dt, v.w};
+    const Float4 p_next{p.x + vh_next.x * m.dt, p.y + vh_next.y * m.dt, p.z + vh_next.z * m.dt, p.w};
+    s.vel[i] = v;
+    s.vel_half_next[i] = vh_next;
+    s.pos_next[i] = p_next;
+    const Float4& b = s.pos_at_build[i];
+    float dx = p_next.x - b.x, dy = p_next.y - b.y, dz = p_next.z - b.z;
+    max_d2 = std::max(max_d2, dx * dx + dy * dy + dz * dz);
+  }
+  return max_d2;
+}
+
+void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin, std::uint32_t end) {
+  for (std::uint32_t i = begin; i < end; ++i) acc[i] = acceleration(s, m, i);
 }
 
 }  // namespace
 
-const Kernels kScalarKernels{"scalar", "none", 1, false, kick_drift, forces_kick};
+const Kernels kScalarKernels{"scalar", "none", 1, false, step, accelerations};
 
 }  // namespace fishtank

@@ -1,8 +1,7 @@
 #pragma once
 // The parts of the SIMD step kernels that work on one ball at a time in four
-// lanes: the kick-drift pass, walls, player spheres, and the force pass around
-// a neighbour loop that each kernel file supplies (4 lanes in kernels_sse.cpp,
-// 8 in kernels_avx2.cpp).
+// lanes: walls, player spheres, and the step pass around a neighbour loop that
+// each kernel file supplies (4 lanes in kernels_sse.cpp, 8 in kernels_avx2.cpp).
 //
 // Both files include this header and are compiled with different -m flags, so
 // everything here has internal linkage: each gets its own copy in its own
@@ -16,21 +15,6 @@ namespace {
 
 using simd::F4;
 using simd::M4;
-
-float kick_drift(const StepArrays& s, const ContactModel& m, std::uint32_t begin, std::uint32_t end) {
-  const F4 half_dt = F4::splat(m.half_dt);
-  const F4 dt_xyz = F4::set(m.dt, m.dt, m.dt, 0.0f);
-  F4 max_d2 = F4::zero();
-  for (std::uint32_t i = begin; i < end; ++i) {
-    F4 vh = F4::load(s.vel[i]) + F4::load(s.acc[i]) * half_dt;  // acc.w == 0 keeps the mass
-    F4 p = F4::load(s.pos[i]) + vh * dt_xyz;
-    vh.store(s.vel_half[i]);
-    p.store(s.pos[i]);
-    F4 d = p - F4::load(s.pos_at_build[i]);  // w lanes are both the radius
-    max_d2 = max(max_d2, dot3(d, d));
-  }
-  return simd::lane(max_d2, 0);
-}
 
 // Kinematic player spheres: the ball's effective mass is its own mass.
 inline F4 player_forces(const StepArrays& s, const ContactModel& m, F4 pi, F4 vi) {
@@ -72,20 +56,45 @@ inline F4 wall_forces(const ContactModel& m, const Walls& walls, F4 pi, F4 vi) {
 }
 
 // PairForces(s, m, i, p_i, v_i) sums the spring-dashpot forces of ball i's neighbours as (Fx, Fy, Fz, 0).
-template <F4 (*PairForces)(const StepArrays&, const ContactModel&, std::uint32_t, F4, F4)>
-void forces_kick(const StepArrays& s, const ContactModel& m, std::uint32_t begin, std::uint32_t end) {
-  const F4 gravity = F4::set(0.0f, -m.gravity, 0.0f, 0.0f);
+using PairForcesFn = F4 (*)(const StepArrays&, const ContactModel&, std::uint32_t, F4, F4);
+
+// a = F / m + g for ball i at position pi with half-step velocity vi. Inlined
+// into the ball loops so the contact constants stay in registers across balls.
+template <PairForcesFn PairForces>
+[[gnu::always_inline]] inline F4 acceleration(const StepArrays& s, const ContactModel& m, const Walls& walls,
+                                              std::uint32_t i, F4 pi, F4 vi) {
+  F4 force = PairForces(s, m, i, pi, vi) + wall_forces(m, walls, pi, vi);
+  if (s.players > 0) force += player_forces(s, m, pi, vi);
+  return force / simd::broadcast<3>(vi) + F4::set(0.0f, -m.gravity, 0.0f, 0.0f);  // force.w == 0, so a.w == 0
+}
+
+template <PairForcesFn PairForces>
+float step(const StepArrays& s, const ContactModel& m, std::uint32_t begin, std::uint32_t end) {
   const F4 half_dt = F4::splat(m.half_dt);
+  const F4 dt_xyz = F4::set(m.dt, m.dt, m.dt, 0.0f);  // keeps the radius in w
   const Walls walls(m.tank);
+  F4 max_d2 = F4::zero();
   for (std::uint32_t i = begin; i < end; ++i) {
     const F4 pi = F4::load(s.pos[i]);
     const F4 vi = F4::load(s.vel_half[i]);
-    F4 force = PairForces(s, m, i, pi, vi) + wall_forces(m, walls, pi, vi);
-    if (s.players > 0) force += player_forces(s, m, pi, vi);
-    F4 a = force / simd::broadcast<3>(vi) + gravity;  // force.w == 0, so a.w == 0
-    a.store(s.acc[i]);
-    (vi + a * half_dt).store(s.vel[i]);
+    const F4 a = acceleration<PairForces>(s, m, walls, i, pi, vi);
+    const F4 v = vi + a * half_dt;
+    const F4 vh_next = v + a * half_dt;
+    const F4 p_next = pi + vh_next * dt_xyz;
+    v.store(s.vel[i]);
+    vh_next.store(s.vel_half_next[i]);
+    p_next.store(s.pos_next[i]);
+    const F4 d = p_next - F4::load(s.pos_at_build[i]);  // w lanes are both the radius
+    max_d2 = max(max_d2, dot3(d, d));
   }
+  return simd::lane(max_d2, 0);
+}
+
+template <PairForcesFn PairForces>
+void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin, std::uint32_t end) {
+  const Walls walls(m.tank);
+  for (std::uint32_t i = begin; i < end; ++i)
+    acceleration<PairForces>(s, m, walls, i, F4::load(s.pos[i]), F4::load(s.vel_half[i])).store(acc[i]);
 }
 
 }  // namespace

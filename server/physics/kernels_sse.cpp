@@ -15,7 +15,8 @@ namespace fishtank {
 namespace {
 
 // Sum over ball i's neighbours of the spring-dashpot force, as (Fx, Fy, Fz, 0).
-inline F4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t i, F4 pi, F4 vi) {
+[[gnu::always_inline]] inline F4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t i, F4 pi,
+                                             F4 vi) {
   // Differences are taken on whole rows before the transpose: pi - pos[j] is
   // (dx, dy, dz, ri - rj) and vi - vel[j] is (dvx, dvy, dvz, mi - mj). That
   // keeps only pi, vi and two broadcasts live instead of eight, so SSE's 16
@@ -59,6 +60,6 @@ inline F4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t 
 
 }  // namespace
 
-const Kernels kSseKernels{"sse", "sse4.1", 4, true, kick_drift, forces_kick<pair_forces>};
+const Kernels kSseKernels{"sse", "sse4.1", 4, true, step<pair_forces>, accelerations<pair_forces>};
 
 }  // namespace fishtank

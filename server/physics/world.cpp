@@ -58,15 +58,15 @@ World::World(const PhysicsParams& params, const Kernels& kernels, int threads, s
 
 void World::resize(std::uint32_t n) {
   n_ = n;
-  for (auto* v : {&pos_, &vel_, &vel_half_, &acc_, &pos_at_build_}) v->resize(n + 1);
+  for (auto* v : {&pos_, &vel_, &vel_half_, &pos_next_, &vel_half_next_, &acc_, &pos_at_build_}) v->resize(n + 1);
   kind_.resize(n);
   id_.resize(n);
   set_ghost();
 }
 
 void World::set_ghost() {
-  pos_[n_] = pos_at_build_[n_] = kGhostPos;
-  vel_[n_] = vel_half_[n_] = kGhostVel;
+  pos_[n_] = pos_next_[n_] = pos_at_build_[n_] = kGhostPos;
+  vel_[n_] = vel_half_[n_] = vel_half_next_[n_] = kGhostVel;
   acc_[n_] = Float4{};
 }
 
@@ -91,8 +91,7 @@ void World::place_ball(int kind, Vec3 p, Vec3 v) {
   std::uint32_t i = n_;
   resize(n_ + 1);
   pos_[i] = {p.x, p.y, p.z, 0.5f * k.diameter};
-  vel_[i] = vel_half_[i] = {v.x, v.y, v.z, k.mass};
-  acc_[i] = {0.0f, -model_.gravity, 0.0f, 0.0f};
+  vel_[i] = {v.x, v.y, v.z, k.mass};
   kind_[i] = static_cast<std::uint8_t>(kind);
   id_[i] = next_id_++;
   energy_added_ += ball_energy(pos_[i], vel_[i], model_.gravity);
@@ -164,11 +163,12 @@ void World::spawn() {
   for (std::size_t b = 0; b < placed_.size(); ++b) {
     std::uint32_t i = first + static_cast<std::uint32_t>(b);
     pos_[i] = placed_[b].pos;
-    vel_[i] = vel_half_[i] = placed_[b].vel;
-    acc_[i] = {0.0f, -model_.gravity, 0.0f, 0.0f};
+    vel_[i] = placed_[b].vel;
     kind_[i] = static_cast<std::uint8_t>(placed_[b].kind);
     id_[i] = next_id_++;
     energy_added_ += ball_energy(pos_[i], vel_[i], model_.gravity);
+    // A spawned ball touches nothing, so gravity is its whole acceleration.
+    next_max_d2_ = std::max(next_max_d2_, kick_drift(i, Float4{0.0f, -model_.gravity, 0.0f, 0.0f}));
   }
   needs_rebuild_ = true;
 }
@@ -178,7 +178,8 @@ void World::rebuild() {
   list_.sort(pos_.data(), n_, order_);
   {
     AlignedVector<Float4> scratch;
-    for (auto* v : {&pos_, &vel_, &vel_half_, &acc_}) apply_order(*v, order_, scratch);
+    // The next-step buffers are not reordered: the pass that follows rewrites them.
+    for (auto* v : {&pos_, &vel_, &vel_half_}) apply_order(*v, order_, scratch);
     std::vector<std::uint8_t> kind_scratch;
     apply_order(kind_, order_, kind_scratch);
     std::vector<std::uint32_t> id_scratch;
@@ -202,54 +203,60 @@ void World::rebuild() {
 }
 
 StepArrays World::arrays() {
-  return StepArrays{pos_.data(),
-                    vel_.data(),
-                    vel_half_.data(),
-                    acc_.data(),
-                    pos_at_build_.data(),
-                    list_.neighbours(),
-                    list_.counts(),
-                    list_.stride(),
-                    player_pos_.data(),
-                    player_vel_.data(),
-                    static_cast<int>(player_pos_.size())};
+  return StepArrays{pos_.data(),        vel_half_.data(),      vel_.data(),
+                    pos_next_.data(),   vel_half_next_.data(), pos_at_build_.data(),
+                    list_.neighbours(), list_.counts(),        list_.stride(),
+                    player_pos_.data(), player_vel_.data(),    static_cast<int>(player_pos_.size())};
 }
 
-void World::compute_initial_forces() {
-  // The first half kick needs a(t0). forces_kick also finishes a kick
-  // (v = v_half + a dt/2), so it runs on a copy of v and v is put back after.
-  PhaseTimer timer(phase_seconds_.forces);
+float World::kick_drift(std::uint32_t i, const Float4& a) {
+  // The same arithmetic as the second half of the step kernels.
+  const Float4& v = vel_[i];
+  const Float4& p = pos_[i];
+  const float h = model_.half_dt;
+  Float4& vh = vel_half_next_[i];
+  vh = Float4{v.x + a.x * h, v.y + a.y * h, v.z + a.z * h, v.w};
+  Float4& next = pos_next_[i];
+  next = Float4{p.x + vh.x * model_.dt, p.y + vh.y * model_.dt, p.z + vh.z * model_.dt, p.w};
+  const Float4& b = pos_at_build_[i];
+  const float dx = next.x - b.x, dy = next.y - b.y, dz = next.z - b.z;
+  return dx * dx + dy * dy + dz * dz;
+}
+
+void World::start_from_current_state() {
+  // The pass needs this step's half-step velocities, which come from a(t):
+  // forces from the current positions with v(t) standing in for v(t - dt/2),
+  // then the first half kick and the drift for every ball.
+  PhaseTimer timer(phase_seconds_.step_pass);
+  if (needs_rebuild_) rebuild();
   std::copy(vel_.begin(), vel_.end(), vel_half_.begin());
   StepArrays s = arrays();
-  pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int) { kernels_.forces_kick(s, model_, begin, end); });
-  std::copy(vel_half_.begin(), vel_half_.end(), vel_.begin());
+  pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int) {
+    kernels_.accelerations(s, model_, acc_.data(), begin, end);
+  });
+  next_max_d2_ = 0.0f;
+  for (std::uint32_t i = 0; i < n_; ++i) next_max_d2_ = std::max(next_max_d2_, kick_drift(i, acc_[i]));
   needs_initial_forces_ = false;
 }
 
 void World::step() {
   if (spawner_.pending() > 0 && steps_ % kSpawnInterval == 0) spawn();
-  if (needs_rebuild_) rebuild();
-  if (needs_initial_forces_) compute_initial_forces();
+  if (needs_initial_forces_) start_from_current_state();
 
-  float max_d2 = 0.0f;
-  {
-    PhaseTimer timer(phase_seconds_.kick_drift);
-    std::fill(thread_max_d2_.begin(), thread_max_d2_.end(), 0.0f);
-    StepArrays s = arrays();
-    pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int thread) {
-      thread_max_d2_[thread] = kernels_.kick_drift(s, model_, begin, end);
-    });
-    for (float d2 : thread_max_d2_) max_d2 = std::max(max_d2, d2);
-    move_players();
-  }
+  // The previous pass's outputs become this step's state.
+  pos_.swap(pos_next_);
+  vel_half_.swap(vel_half_next_);
+  move_players();
   const float half_skin = 0.5f * params_.skin;
-  if (!(max_d2 <= half_skin * half_skin)) rebuild();  // NaN also forces a rebuild
+  if (needs_rebuild_ || !(next_max_d2_ <= half_skin * half_skin)) rebuild();  // NaN also forces a rebuild
 
-  {
-    PhaseTimer timer(phase_seconds_.forces);
-    StepArrays s = arrays();
-    pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int) { kernels_.forces_kick(s, model_, begin, end); });
-  }
+  PhaseTimer timer(phase_seconds_.step_pass);
+  std::fill(thread_max_d2_.begin(), thread_max_d2_.end(), 0.0f);
+  StepArrays s = arrays();
+  pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int thread) {
+    thread_max_d2_[thread] = kernels_.step(s, model_, begin, end);
+  });
+  next_max_d2_ = *std::max_element(thread_max_d2_.begin(), thread_max_d2_.end());
   time_ += model_.dt;
   ++steps_;
 }

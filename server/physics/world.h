@@ -5,10 +5,14 @@
 // One step (server/physics/world.cpp, step()):
 //
 //   spawn round (every kSpawnInterval steps while balls are queued)
-//   kick_drift   ║ parallel over balls   v_half = v + a dt/2, x += v_half dt
+//   swap           the last pass's pos_next, vel_half_next become pos, vel_half
 //   players move   (serial, few)
 //   rebuild?       if a ball moved > skin/2: sort by cell, reorder, new lists
-//   forces_kick  ║ parallel over balls   a = F/m + g, v = v_half + a dt/2
+//   step pass    ║ parallel over balls (kernels.h): a = F/m + g, v = v_half + a dt/2,
+//                  then the next half kick and drift into pos_next, vel_half_next
+//
+// Between steps pos and vel are the state at time(); the next step's
+// positions are already computed, so one pass and one barrier make a step.
 //
 // Ball arrays are reordered by every rebuild; id() gives each ball's
 // permanent number (its order of appearance) for anyone who tracks balls.
@@ -29,9 +33,8 @@ namespace fishtank {
 
 struct PhaseSeconds {
   double spawn = 0.0;
-  double kick_drift = 0.0;
-  double neighbours = 0.0;
-  double forces = 0.0;
+  double neighbours = 0.0;  // sort, reorder and list build
+  double step_pass = 0.0;   // forces and integration
 };
 
 struct AddResult {
@@ -113,8 +116,12 @@ class World {
  private:
   void spawn();
   void rebuild();
-  // Placed balls may start in contact: their first half kick needs the real force.
-  void compute_initial_forces();
+  // Placed balls may start in contact: their first half kick needs the real
+  // force, so the next step's half-step state is computed anew for every ball.
+  void start_from_current_state();
+  // Ball i's half kick with acceleration a and drift into the next-step
+  // buffers; returns its squared distance from where the lists were built.
+  float kick_drift(std::uint32_t i, const Float4& a);
   void move_players();
   void resize(std::uint32_t n);
   void set_ghost();
@@ -128,13 +135,17 @@ class World {
   NeighbourList list_;
 
   std::uint32_t n_ = 0;
-  // n_ balls, then one ghost far away that pads neighbour lists to a multiple of 4.
-  AlignedVector<Float4> pos_, vel_, vel_half_, acc_, pos_at_build_;
+  // n_ balls, then one ghost far away that pads neighbour lists.
+  AlignedVector<Float4> pos_, vel_, vel_half_;
+  AlignedVector<Float4> pos_next_, vel_half_next_;  // written by the step pass
+  AlignedVector<Float4> acc_;                       // scratch of start_from_current_state()
+  AlignedVector<Float4> pos_at_build_;
   std::vector<std::uint8_t> kind_;
   std::vector<std::uint32_t> id_;
   std::uint32_t next_id_ = 0;
   bool needs_rebuild_ = true;
   bool needs_initial_forces_ = false;
+  float next_max_d2_ = 0.0f;  // largest squared distance of pos_next from pos_at_build
 
   std::vector<std::uint32_t> player_ids_;
   AlignedVector<Float4> player_pos_, player_vel_;

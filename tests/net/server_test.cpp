@@ -162,14 +162,15 @@ TEST_CASE("PlayerInput moves that client's sphere which pushes the balls it touc
     for (std::size_t i = 0; i < a.size(); ++i) n += length(a[i] - b[i]) > d;
     return n;
   };
-  // Control: wait until the pile has settled, i.e. while the sphere stands
-  // still no ball moves more than 0.3 units in half a second.
+  // Control: wait until the pile is at rest, i.e. while the sphere stands
+  // still at most two balls move more than 0.3 units in half a second (with
+  // no friction, a ball can glide on the floor for many seconds).
   std::vector<Vec3> rest = positions();
   bool settled = false;
-  for (int tries = 0; tries < 30 && !settled; ++tries) {
+  for (int tries = 0; tries < 40 && !settled; ++tries) {
     clients.run_for(std::chrono::milliseconds(500));
     std::vector<Vec3> now = positions();
-    settled = moved_more_than(rest, now, 0.3f) == 0;
+    settled = moved_more_than(rest, now, 0.3f) <= 2;
     rest = std::move(now);
   }
   REQUIRE(settled);
@@ -185,7 +186,8 @@ TEST_CASE("PlayerInput moves that client's sphere which pushes the balls it touc
   clients.run_for(std::chrono::milliseconds(200));
   const Vec3 end = *observer->player_position(id);
   CHECK(end.x > low.x + 8.0f);
-  CHECK(moved_more_than(rest, positions(), 0.3f) >= 3);
+  INFO("balls moved by the sweep: " << moved_more_than(rest, positions(), 0.3f));
+  CHECK(moved_more_than(rest, positions(), 0.3f) >= 10);  // the sweep, not the gliders
   CHECK(player->stats().errors.empty());
 
   player->close();
