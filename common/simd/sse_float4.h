@@ -1,10 +1,12 @@
 #pragma once
-// Thin, explicit wrapper over SSE4.1 intrinsics: four float lanes (F4) and a
-// lane mask (M4). Only the SSE twins include this; the scalar twins are plain
+// Thin, explicit wrapper over SSE4.1 intrinsics: four float lanes (F4), a
+// lane mask (M4) and four indices (I4). Only the SSE twins include this; the scalar twins are plain
 // C++. Every operation maps to one or two instructions, so the kernels read as
 // arithmetic while the generated code stays predictable.
 
 #include <smmintrin.h>
+
+#include <cstdint>
 
 #include "common/float4.h"
 
@@ -74,6 +76,41 @@ inline F4 sum_lanes_xyz(F4 xs, F4 ys, F4 zs) {
   __m128 t0 = _mm_hadd_ps(xs.v, ys.v);              // x01 x23 y01 y23
   __m128 t1 = _mm_hadd_ps(zs.v, _mm_setzero_ps());  // z01 z23 0 0
   return {_mm_hadd_ps(t0, t1)};                     // x y z 0
+}
+
+inline M4 operator&(M4 a, M4 b) { return {_mm_and_ps(a.v, b.v)}; }
+inline int bits(M4 m) { return _mm_movemask_ps(m.v); }  // lane L's flag in bit L
+
+// Four 32-bit indices, for building lists.
+struct I4 {
+  __m128i v;
+  static I4 splat(std::uint32_t s) { return {_mm_set1_epi32(static_cast<int>(s))}; }
+  static I4 iota(std::uint32_t first) {  // first, first + 1, first + 2, first + 3
+    return {_mm_add_epi32(_mm_set1_epi32(static_cast<int>(first)), _mm_setr_epi32(0, 1, 2, 3))};
+  }
+};
+// Signed compares: indices stay below 2^31.
+inline M4 operator<(I4 a, I4 b) { return {_mm_castsi128_ps(_mm_cmplt_epi32(a.v, b.v))}; }
+inline M4 operator!=(I4 a, I4 b) {
+  return {_mm_castsi128_ps(_mm_xor_si128(_mm_cmpeq_epi32(a.v, b.v), _mm_set1_epi32(-1)))};
+}
+
+// The lanes of a whose bit is set in mask, packed to the front in lane order
+// and stored at out; all 16 bytes are written, whatever the count.
+inline void compress_store(I4 a, int mask, std::uint32_t* out) {
+  // Byte shuffles that gather the chosen 32-bit lanes, one per 4-bit mask.
+  alignas(16) static constexpr std::uint8_t kGather[16][16] = {
+      {0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3},       {0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3},
+      {4, 5, 6, 7, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3},       {0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 0, 1, 2, 3},
+      {8, 9, 10, 11, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3},     {0, 1, 2, 3, 8, 9, 10, 11, 0, 1, 2, 3, 0, 1, 2, 3},
+      {4, 5, 6, 7, 8, 9, 10, 11, 0, 1, 2, 3, 0, 1, 2, 3},     {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 0, 1, 2, 3},
+      {12, 13, 14, 15, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3},   {0, 1, 2, 3, 12, 13, 14, 15, 0, 1, 2, 3, 0, 1, 2, 3},
+      {4, 5, 6, 7, 12, 13, 14, 15, 0, 1, 2, 3, 0, 1, 2, 3},   {0, 1, 2, 3, 4, 5, 6, 7, 12, 13, 14, 15, 0, 1, 2, 3},
+      {8, 9, 10, 11, 12, 13, 14, 15, 0, 1, 2, 3, 0, 1, 2, 3}, {0, 1, 2, 3, 8, 9, 10, 11, 12, 13, 14, 15, 0, 1, 2, 3},
+      {4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 0, 1, 2, 3}, {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15},
+  };
+  const __m128i gather = _mm_load_si128(reinterpret_cast<const __m128i*>(kGather[mask]));
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm_shuffle_epi8(a.v, gather));
 }
 
 inline float lane(F4 a, int i) {

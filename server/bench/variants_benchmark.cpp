@@ -1,14 +1,21 @@
-// Google Benchmark of whole physics steps for every kernel set on one settled
-// tank, so the variants' ratios come from one process and one state.
+// Google Benchmark of whole physics steps, so ratios come from one process:
+//   step_tank/<variant>/<threads>  every kernel set on one settled 6000-ball tank
+//   step_wide/sse/<balls>          the wide scene at 10^4, 10^5 and 10^6 balls
+//                                  (SSE on every core), each stepped 50 steps
+//                                  per repetition so all sizes advance through
+//                                  the same stretch of simulated time
 //
 // A shared virtual machine's speed drifts by tens of percent over minutes.
-// Run with random interleaving and repetitions (as scripts/bench-kernels does)
-// so every variant samples the same drift, and compare medians.
+// Run with random interleaving and repetitions so every case samples the same
+// drift, and compare medians; --benchmark_filter=step_tank or step_wide picks
+// a family (the wide worlds take a few minutes to build).
 
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
 #include <functional>
+#include <map>
+#include <memory>
 #include <vector>
 
 #include "common/fp_env.h"
@@ -22,6 +29,7 @@ using fishtank::World;
 // The settled 6000-ball tank every benchmark starts from, made once.
 const std::vector<fishtank::BallView>& settled_tank() {
   static const std::vector<fishtank::BallView> balls = [] {
+    std::fprintf(stderr, "settling the 6000-ball tank every step_tank case starts from...\n");
     fishtank::SceneSpec spec;  // tank, 6000 balls
     World world(fishtank::PhysicsParams{}, fishtank::kSseKernels, fishtank::WorkerPool::hardware_threads(), 1);
     fishtank::populate(world, spec);
@@ -45,6 +53,33 @@ void step_tank(benchmark::State& state, const fishtank::Kernels& kernels) {
       benchmark::Counter(double(state.iterations()) * world.ball_count(), benchmark::Counter::kIsRate);
 }
 
+// One wide-scene world per size, dropped and run for the scene's 4 simulated
+// seconds on first use, then stepped on by every repetition.
+World& wide_world(std::uint32_t balls) {
+  static std::map<std::uint32_t, std::unique_ptr<World>> worlds;
+  std::unique_ptr<World>& world = worlds[balls];
+  if (!world) {
+    std::fprintf(stderr, "building the %u-ball wide scene...\n", balls);
+    fishtank::SceneSpec spec;
+    spec.name = "wide";
+    spec.balls = balls;
+    fishtank::PhysicsParams params;
+    params.tank = fishtank::scene_tank(spec);
+    world = std::make_unique<World>(params, fishtank::kSseKernels, fishtank::WorkerPool::hardware_threads(), 1);
+    fishtank::populate(*world, spec);
+    fishtank::settle(*world, spec);
+  }
+  return *world;
+}
+
+void step_wide(benchmark::State& state) {
+  fishtank::enable_flush_denormals_to_zero();
+  World& world = wide_world(static_cast<std::uint32_t>(state.range(0)));
+  for (auto _ : state) world.step();
+  state.counters["ball_steps_per_s"] =
+      benchmark::Counter(double(state.iterations()) * world.ball_count(), benchmark::Counter::kIsRate);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -57,10 +92,14 @@ int main(int argc, char** argv) {
   add("step_tank/scalar", fishtank::kScalarKernels, false);
   add("step_tank/sse", fishtank::kSseKernels, true);
   if (fishtank::cpu_has_avx2()) add("step_tank/avx2", fishtank::kAvx2Kernels, true);
+  benchmark::RegisterBenchmark("step_wide/sse", step_wide)
+      ->Arg(10000)
+      ->Arg(100000)
+      ->Arg(1000000)
+      ->Iterations(50)
+      ->Unit(benchmark::kMillisecond);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  std::fprintf(stderr, "settling the 6000-ball tank every benchmark starts from...\n");
-  settled_tank();
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "server/physics/kernels.h"
-
 namespace fishtank {
 
 void NeighbourList::configure(const TankBounds& tank, float skin) {
@@ -57,36 +55,9 @@ void NeighbourList::reserve(std::uint32_t n, std::uint32_t stride) {
   counts_.resize(n);
 }
 
-std::uint32_t NeighbourList::build(const Float4* pos, std::uint32_t n, std::uint32_t begin, std::uint32_t end) {
-  const std::uint32_t ghost = n;  // the world keeps a far-away ball at index n
-  std::uint32_t longest = 0;
-  for (std::uint32_t i = begin; i < end; ++i) {
-    const Float4 pi = pos[i];
-    const int cell = static_cast<int>(sorted_cell_[i]);
-    const int cx = cell % nx_, cy = (cell / nx_) % ny_, cz = cell / (nx_ * ny_);
-    const int x_lo = std::max(cx - 1, 0), x_hi = std::min(cx + 1, nx_ - 1);
-    std::uint32_t* list = neighbours_.data() + std::size_t(i) * stride_;
-    std::uint32_t count = 0;
-    for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, nz_ - 1); ++z) {
-      for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, ny_ - 1); ++y) {
-        const std::size_t row = std::size_t(nx_) * (y + std::size_t(ny_) * z);
-        const std::uint32_t j_end = cell_start_[row + x_hi + 1];
-        for (std::uint32_t j = cell_start_[row + x_lo]; j < j_end; ++j) {
-          const Float4& pj = pos[j];
-          float dx = pi.x - pj.x, dy = pi.y - pj.y, dz = pi.z - pj.z;
-          float cutoff = pi.w + pj.w + skin_;
-          if (dx * dx + dy * dy + dz * dz >= cutoff * cutoff || j == i) continue;
-          if (count < stride_) list[count] = j;
-          ++count;
-        }
-      }
-    }
-    counts_[i] = count;
-    for (std::uint32_t pad = count; pad < std::min(padded_neighbour_count(count, kListPadding), stride_); ++pad)
-      list[pad] = ghost;
-    longest = std::max(longest, count);
-  }
-  return longest;
+ListBuild NeighbourList::build_view(const Float4* pos, std::uint32_t n) {
+  return ListBuild{pos, n,     cell_start_.data(), sorted_cell_.data(), nx_,    ny_,
+                   nz_, skin_, neighbours_.data(), counts_.data(),      stride_};
 }
 
 }  // namespace fishtank

@@ -1,5 +1,6 @@
 #pragma once
-// The hot pass of a step, in twins with the same signature:
+// The hot passes of a step (the step pass and the neighbour-list build), in
+// twins with the same signatures:
 //   kernels_scalar.cpp  plain C++, one pair at a time (the reference)
 //   kernels_sse.cpp     SSE4.1, four neighbours at a time
 //   kernels_avx2.cpp    AVX2 + FMA, eight neighbours at a time (a third level)
@@ -18,6 +19,7 @@
 #include <cstdint>
 
 #include "common/float4.h"
+#include "server/physics/broadphase.h"
 #include "server/physics/params.h"
 
 namespace fishtank {
@@ -52,6 +54,8 @@ struct Kernels {
   // not known yet (balls placed in contact). Writes none of s's outputs.
   void (*accelerations)(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin,
                         std::uint32_t end);
+  // Neighbour lists of balls [begin, end) (see broadphase.h). Returns the longest.
+  std::uint32_t (*build_lists)(const ListBuild& b, std::uint32_t begin, std::uint32_t end);
 };
 
 extern const Kernels kScalarKernels;
@@ -59,11 +63,5 @@ extern const Kernels kSseKernels;
 extern const Kernels kAvx2Kernels;  // run only where cpu_has_avx2()
 
 inline bool cpu_has_avx2() { return __builtin_cpu_supports("avx2"); }
-
-// Lists are padded for the widest kernel; a narrower one reads a shorter prefix.
-constexpr std::uint32_t kListPadding = 8;
-inline std::uint32_t padded_neighbour_count(std::uint32_t count, std::uint32_t lanes) {
-  return (count + lanes - 1) / lanes * lanes;
-}
 
 }  // namespace fishtank

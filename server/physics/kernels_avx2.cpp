@@ -66,6 +66,6 @@ using simd::M8;
 
 }  // namespace
 
-const Kernels kAvx2Kernels{"avx2", "avx2+fma", 8, true, step<pair_forces>, accelerations<pair_forces>};
+const Kernels kAvx2Kernels{"avx2", "avx2+fma", 8, true, step<pair_forces>, accelerations<pair_forces>, build_lists};
 
 }  // namespace fishtank

@@ -96,8 +96,29 @@ void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std:
   for (std::uint32_t i = begin; i < end; ++i) acc[i] = acceleration(s, m, i);
 }
 
+std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t end) {
+  std::uint32_t longest = 0;
+  for (std::uint32_t i = begin; i < end; ++i) {
+    const Float4 pi = b.pos[i];
+    std::uint32_t* list = b.neighbours + std::size_t(i) * b.stride;
+    std::uint32_t count = 0;
+    for_each_neighbour_range(b, i, [&](std::uint32_t j_begin, std::uint32_t j_end) {
+      for (std::uint32_t j = j_begin; j < j_end; ++j) {
+        const Float4& pj = b.pos[j];
+        float dx = pi.x - pj.x, dy = pi.y - pj.y, dz = pi.z - pj.z;
+        float cutoff = pi.w + pj.w + b.skin;
+        if (dx * dx + dy * dy + dz * dz >= cutoff * cutoff || j == i) continue;
+        if (count < b.stride) list[count] = j;
+        ++count;
+      }
+    });
+    longest = std::max(longest, finish_list(b, i, count));
+  }
+  return longest;
+}
+
 }  // namespace
 
-const Kernels kScalarKernels{"scalar", "none", 1, false, step, accelerations};
+const Kernels kScalarKernels{"scalar", "none", 1, false, step, accelerations, build_lists};
 
 }  // namespace fishtank

@@ -1,11 +1,14 @@
 #pragma once
-// The parts of the SIMD step kernels that work on one ball at a time in four
-// lanes: walls, player spheres, and the step pass around a neighbour loop that
-// each kernel file supplies (4 lanes in kernels_sse.cpp, 8 in kernels_avx2.cpp).
+// The parts of the SIMD kernels that work on one ball at a time in four lanes:
+// walls, player spheres, the step pass around a neighbour loop that each
+// kernel file supplies (4 lanes in kernels_sse.cpp, 8 in kernels_avx2.cpp),
+// and the neighbour-list build.
 //
 // Both files include this header and are compiled with different -m flags, so
 // everything here has internal linkage: each gets its own copy in its own
 // instruction set, and the linker can never hand AVX2 code to the SSE build.
+
+#include <algorithm>
 
 #include "common/simd/sse_float4.h"
 #include "server/physics/kernels.h"
@@ -95,6 +98,46 @@ void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std:
   const Walls walls(m.tank);
   for (std::uint32_t i = begin; i < end; ++i)
     acceleration<PairForces>(s, m, walls, i, F4::load(s.pos[i]), F4::load(s.vel_half[i])).store(acc[i]);
+}
+
+// Lists four candidates at a time: a cell range is contiguous in the sorted
+// arrays, so four consecutive balls are tested at once and the indices of
+// those within reach are packed into the list with one byte shuffle, with no
+// branch per candidate (the scalar build mispredicts on most of them).
+inline std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t end) {
+  const F4 skin = F4::splat(b.skin);
+  std::uint32_t longest = 0;
+  for (std::uint32_t i = begin; i < end; ++i) {
+    const F4 pi = F4::load(b.pos[i]);
+    const F4 two_ri_skin = simd::broadcast<3>(pi) + simd::broadcast<3>(pi) + skin;
+    const simd::I4 self = simd::I4::splat(i);
+    std::uint32_t* list = b.neighbours + std::size_t(i) * b.stride;
+    std::uint32_t count = 0;
+    for_each_neighbour_range(b, i, [&](std::uint32_t j_begin, std::uint32_t j_end) {
+      const simd::I4 range_end = simd::I4::splat(j_end);
+      for (std::uint32_t j = j_begin; j < j_end; j += 4) {  // may read up to 3 ghosts past the end
+        F4 dx, dy, dz, ri_minus_rj;
+        simd::transpose(pi - F4::load(b.pos[j]), pi - F4::load(b.pos[j + 1]), pi - F4::load(b.pos[j + 2]),
+                        pi - F4::load(b.pos[j + 3]), dx, dy, dz, ri_minus_rj);
+        const F4 cutoff = two_ri_skin - ri_minus_rj;  // ri + rj + skin
+        const simd::I4 index = simd::I4::iota(j);
+        int found = bits((dx * dx + dy * dy + dz * dz < cutoff * cutoff) & (index < range_end) & (index != self));
+        if (found == 0) continue;
+        if (count + 4 > b.stride) {  // nearly full: one by one, counting on so the caller can grow the list
+          for (std::uint32_t lane = 0; lane < 4; ++lane, found >>= 1)
+            if (found & 1) {
+              if (count < b.stride) list[count] = j + lane;
+              ++count;
+            }
+          continue;
+        }
+        compress_store(index, found, list + count);
+        count += __builtin_popcount(found);
+      }
+    });
+    longest = std::max(longest, finish_list(b, i, count));
+  }
+  return longest;
 }
 
 }  // namespace

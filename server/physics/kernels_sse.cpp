@@ -60,6 +60,6 @@ namespace {
 
 }  // namespace
 
-const Kernels kSseKernels{"sse", "sse4.1", 4, true, step<pair_forces>, accelerations<pair_forces>};
+const Kernels kSseKernels{"sse", "sse4.1", 4, true, step<pair_forces>, accelerations<pair_forces>, build_lists};
 
 }  // namespace fishtank

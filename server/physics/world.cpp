@@ -31,14 +31,6 @@ double ball_energy(const Float4& pos, const Float4& vel, float gravity) {
   return 0.5 * vel.w * speed2 + double(vel.w) * gravity * pos.y;
 }
 
-template <class Vector>
-void apply_order(Vector& v, const std::vector<std::uint32_t>& order, Vector& scratch) {
-  scratch.resize(v.size());
-  for (std::size_t k = 0; k < order.size(); ++k) scratch[k] = v[order[k]];
-  for (std::size_t k = order.size(); k < v.size(); ++k) scratch[k] = v[k];
-  v.swap(scratch);
-}
-
 }  // namespace
 
 World::World(const PhysicsParams& params, const Kernels& kernels, int threads, std::uint64_t seed)
@@ -58,16 +50,19 @@ World::World(const PhysicsParams& params, const Kernels& kernels, int threads, s
 
 void World::resize(std::uint32_t n) {
   n_ = n;
-  for (auto* v : {&pos_, &vel_, &vel_half_, &pos_next_, &vel_half_next_, &acc_, &pos_at_build_}) v->resize(n + 1);
+  for (auto* v : {&pos_, &vel_, &vel_half_, &pos_next_, &vel_half_next_, &acc_, &pos_at_build_})
+    v->resize(n + kGhostSlots);
   kind_.resize(n);
   id_.resize(n);
   set_ghost();
 }
 
 void World::set_ghost() {
-  pos_[n_] = pos_next_[n_] = pos_at_build_[n_] = kGhostPos;
-  vel_[n_] = vel_half_[n_] = vel_half_next_[n_] = kGhostVel;
-  acc_[n_] = Float4{};
+  for (std::uint32_t g = n_; g < n_ + kGhostSlots; ++g) {
+    pos_[g] = pos_next_[g] = pos_at_build_[g] = kGhostPos;
+    vel_[g] = vel_half_[g] = vel_half_next_[g] = kGhostVel;
+    acc_[g] = Float4{};
+  }
 }
 
 AddResult World::add_balls(std::int64_t count) {
@@ -176,23 +171,35 @@ void World::spawn() {
 void World::rebuild() {
   PhaseTimer timer(phase_seconds_.neighbours);
   list_.sort(pos_.data(), n_, order_);
-  {
-    AlignedVector<Float4> scratch;
-    // The next-step buffers are not reordered: the pass that follows rewrites them.
-    for (auto* v : {&pos_, &vel_, &vel_half_}) apply_order(*v, order_, scratch);
-    std::vector<std::uint8_t> kind_scratch;
-    apply_order(kind_, order_, kind_scratch);
-    std::vector<std::uint32_t> id_scratch;
-    apply_order(id_, order_, id_scratch);
-  }
-  std::copy(pos_.begin(), pos_.end(), pos_at_build_.begin());
+  // Gather every per-ball array into cell order, in parallel. The next-step
+  // buffers and acc_ are free here (the pass that follows rewrites them), so
+  // they take the gathered copies and then swap places with the originals.
+  kind_scratch_.resize(kind_.size());
+  id_scratch_.resize(id_.size());
+  pool_.run(n_, [this](std::uint32_t begin, std::uint32_t end, int) {
+    for (std::uint32_t k = begin; k < end; ++k) {
+      const std::uint32_t from = order_[k];
+      pos_next_[k] = pos_at_build_[k] = pos_[from];
+      vel_half_next_[k] = vel_half_[from];
+      acc_[k] = vel_[from];
+      kind_scratch_[k] = kind_[from];
+      id_scratch_[k] = id_[from];
+    }
+  });
+  pos_.swap(pos_next_);
+  vel_half_.swap(vel_half_next_);
+  vel_.swap(acc_);
+  kind_.swap(kind_scratch_);
+  id_.swap(id_scratch_);
+  set_ghost();  // the swapped-in buffers' tails
 
   if (list_.stride() == 0) list_.reserve(n_, 32);
   for (;;) {
     list_.reserve(n_, list_.stride());
     std::fill(thread_longest_.begin(), thread_longest_.end(), 0u);
-    pool_.run(n_, [this](std::uint32_t begin, std::uint32_t end, int thread) {
-      thread_longest_[thread] = list_.build(pos_.data(), n_, begin, end);
+    const ListBuild build = list_.build_view(pos_.data(), n_);
+    pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int thread) {
+      thread_longest_[thread] = kernels_.build_lists(build, begin, end);
     });
     std::uint32_t longest = *std::max_element(thread_longest_.begin(), thread_longest_.end());
     if (longest <= list_.stride()) break;

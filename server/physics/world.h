@@ -135,13 +135,13 @@ class World {
   NeighbourList list_;
 
   std::uint32_t n_ = 0;
-  // n_ balls, then one ghost far away that pads neighbour lists.
+  // n_ balls, then kGhostSlots ghosts far away (index n_ pads neighbour lists).
   AlignedVector<Float4> pos_, vel_, vel_half_;
   AlignedVector<Float4> pos_next_, vel_half_next_;  // written by the step pass
-  AlignedVector<Float4> acc_;                       // scratch of start_from_current_state()
+  AlignedVector<Float4> acc_;                       // scratch: start_from_current_state(), rebuild()
   AlignedVector<Float4> pos_at_build_;
-  std::vector<std::uint8_t> kind_;
-  std::vector<std::uint32_t> id_;
+  std::vector<std::uint8_t> kind_, kind_scratch_;
+  std::vector<std::uint32_t> id_, id_scratch_;
   std::uint32_t next_id_ = 0;
   bool needs_rebuild_ = true;
   bool needs_initial_forces_ = false;

@@ -1,0 +1,107 @@
+// Every list-build kernel finds exactly the pairs within r_i + r_j + skin, in
+// the same order, and reports lists that do not fit instead of overrunning.
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <random>
+
+#include "tests/physics/scenarios.h"
+
+using namespace fishtank;
+using namespace fishtank::test;
+
+namespace {
+
+struct Lists {
+  std::vector<std::uint32_t> counts;
+  std::vector<std::vector<std::uint32_t>> entries;  // the stored part of each list
+  std::uint32_t longest = 0;
+};
+
+// n random balls of every kind, packed densely enough that many lists are long.
+AlignedVector<Float4> random_balls(const TankBounds& tank, std::uint32_t n) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> x(tank.min.x, tank.max.x), y(tank.min.y, tank.max.y), z(tank.min.z, tank.max.z);
+  AlignedVector<Float4> pos(n + kGhostSlots, Float4{1e6f, 1e6f, 1e6f, 0.0f});
+  for (std::uint32_t i = 0; i < n; ++i) pos[i] = {x(rng), y(rng), z(rng), 0.5f * kBallKinds[i % kKindCount].diameter};
+  return pos;
+}
+
+Lists build(const Kernels& kernels, const TankBounds& tank, const AlignedVector<Float4>& unsorted, std::uint32_t n,
+            std::uint32_t stride) {
+  NeighbourList list;
+  list.configure(tank, 0.2f);
+  std::vector<std::uint32_t> order;
+  list.sort(unsorted.data(), n, order);
+  AlignedVector<Float4> pos(unsorted);
+  for (std::uint32_t k = 0; k < n; ++k) pos[k] = unsorted[order[k]];
+  list.reserve(n, stride);
+  Lists out;
+  out.longest = kernels.build_lists(list.build_view(pos.data(), n), 0, n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    out.counts.push_back(list.counts()[i]);
+    const std::uint32_t* l = list.neighbours() + std::size_t(i) * list.stride();
+    out.entries.emplace_back(l, l + std::min(list.counts()[i], list.stride()));
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("every list build finds the same neighbours as a brute-force search", "[physics][broadphase]") {
+  TankBounds tank;
+  tank.min = {-10.0f, 0.0f, -10.0f};
+  tank.max = {10.0f, 20.0f, 10.0f};
+  const std::uint32_t n = 3000;
+  const AlignedVector<Float4> balls = random_balls(tank, n);
+  const Lists scalar = build(kScalarKernels, tank, balls, n, 64);
+  REQUIRE(scalar.longest <= 64);
+
+  // Brute force over the same sorted order: the scalar build is the reference.
+  NeighbourList grid;
+  grid.configure(tank, 0.2f);
+  std::vector<std::uint32_t> order;
+  grid.sort(balls.data(), n, order);
+  std::size_t pairs = 0;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    std::vector<std::uint32_t> expected;
+    const Float4& a = balls[order[i]];
+    for (std::uint32_t j = 0; j < n; ++j) {
+      const Float4& b = balls[order[j]];
+      const float dx = a.x - b.x, dy = a.y - b.y, dz = a.z - b.z, cut = a.w + b.w + 0.2f;
+      if (j != i && dx * dx + dy * dy + dz * dz < cut * cut) expected.push_back(j);
+    }
+    std::vector<std::uint32_t> got = scalar.entries[i];
+    std::sort(got.begin(), got.end());
+    REQUIRE(got == expected);
+    pairs += expected.size();
+  }
+  REQUIRE(pairs > 10 * n);  // dense enough that lists span several SIMD blocks
+
+  for (const std::string& name : variant_names()) {
+    INFO(name);
+    const Lists simd = build(kernels_named(name), tank, balls, n, 64);
+    CHECK(simd.counts == scalar.counts);
+    CHECK(simd.entries == scalar.entries);  // same neighbours in the same order
+  }
+}
+
+TEST_CASE("a list longer than the stride is counted in full and keeps its first entries", "[physics][broadphase]") {
+  TankBounds tank;
+  tank.min = {-10.0f, 0.0f, -10.0f};
+  tank.max = {10.0f, 20.0f, 10.0f};
+  const std::uint32_t n = 3000;
+  const AlignedVector<Float4> balls = random_balls(tank, n);
+  const Lists full = build(kScalarKernels, tank, balls, n, 64);
+  for (const std::string& name : variant_names()) {
+    INFO(name);
+    const Lists cut = build(kernels_named(name), tank, balls, n, 8);
+    CHECK(cut.longest == full.longest);
+    CHECK(cut.counts == full.counts);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      // The stored part is the first entries of the full list.
+      const std::vector<std::uint32_t>& f = full.entries[i];
+      REQUIRE(cut.entries[i] == std::vector<std::uint32_t>(f.begin(), f.begin() + std::min<std::size_t>(f.size(), 8)));
+    }
+  }
+}
