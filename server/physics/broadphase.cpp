@@ -14,28 +14,30 @@ void NeighbourList::configure(const TankBounds& tank, float skin) {
   ny_ = std::max(1, static_cast<int>(size.y / min_edge));
   nz_ = std::max(1, static_cast<int>(size.z / min_edge));
   inv_edge_ = {nx_ / size.x, ny_ / size.y, nz_ / size.z};
-  cell_start_.assign(std::size_t(nx_) * ny_ * nz_ + 1, 0);
+  block_ = std::min(kBlockCells, nx_);
+  const int blocks = (nx_ + block_ - 1) / block_;  // the last may be part empty
+  cell_start_.assign(std::size_t(blocks) * block_ * ny_ * nz_ + 1, 0);
 }
 
-std::uint32_t NeighbourList::cell_of(const Float4& p) const {
+CellCoord NeighbourList::cell_of(const Float4& p) const {
   // fmin/fmax also send NaN to a valid cell; balls pushed outside the tank go
   // to the border cell, which still finds all their neighbours.
   auto axis = [](float pos, float lo, float inv_edge, int cells) {
     float c = std::floor((pos - lo) * inv_edge);
-    return static_cast<std::uint32_t>(std::fmin(std::fmax(c, 0.0f), float(cells - 1)));
+    return static_cast<std::int32_t>(std::fmin(std::fmax(c, 0.0f), float(cells - 1)));
   };
-  std::uint32_t cx = axis(p.x, tank_.min.x, inv_edge_.x, nx_);
-  std::uint32_t cy = axis(p.y, tank_.min.y, inv_edge_.y, ny_);
-  std::uint32_t cz = axis(p.z, tank_.min.z, inv_edge_.z, nz_);
-  return cx + std::uint32_t(nx_) * (cy + std::uint32_t(ny_) * cz);
+  return {axis(p.x, tank_.min.x, inv_edge_.x, nx_), axis(p.y, tank_.min.y, inv_edge_.y, ny_),
+          axis(p.z, tank_.min.z, inv_edge_.z, nz_)};
 }
 
 void NeighbourList::sort(const Float4* pos, std::uint32_t n, std::vector<std::uint32_t>& order) {
   scratch_cell_.resize(n);
+  scratch_number_.resize(n);
   std::fill(cell_start_.begin(), cell_start_.end(), 0u);
   for (std::uint32_t i = 0; i < n; ++i) {
-    scratch_cell_[i] = cell_of(pos[i]);
-    ++cell_start_[scratch_cell_[i] + 1];
+    const CellCoord c = scratch_cell_[i] = cell_of(pos[i]);
+    scratch_number_[i] = static_cast<std::uint32_t>(cell_number(c.x, c.y, c.z, ny_, nz_, block_));
+    ++cell_start_[scratch_number_[i] + 1];
   }
   for (std::size_t c = 1; c < cell_start_.size(); ++c) cell_start_[c] += cell_start_[c - 1];
 
@@ -43,7 +45,7 @@ void NeighbourList::sort(const Float4* pos, std::uint32_t n, std::vector<std::ui
   sorted_cell_.resize(n);
   std::vector<std::uint32_t> next(cell_start_.begin(), cell_start_.end() - 1);
   for (std::uint32_t i = 0; i < n; ++i) {
-    std::uint32_t slot = next[scratch_cell_[i]]++;
+    std::uint32_t slot = next[scratch_number_[i]]++;
     order[slot] = i;
     sorted_cell_[slot] = scratch_cell_[i];
   }
@@ -56,8 +58,8 @@ void NeighbourList::reserve(std::uint32_t n, std::uint32_t stride) {
 }
 
 ListBuild NeighbourList::build_view(const Float4* pos, std::uint32_t n) {
-  return ListBuild{pos, n,     cell_start_.data(), sorted_cell_.data(), nx_,    ny_,
-                   nz_, skin_, neighbours_.data(), counts_.data(),      stride_};
+  return ListBuild{pos,    n,     cell_start_.data(), sorted_cell_.data(), nx_,    ny_, nz_,
+                   block_, skin_, neighbours_.data(), counts_.data(),      stride_};
 }
 
 }  // namespace fishtank

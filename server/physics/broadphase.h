@@ -1,10 +1,14 @@
 #pragma once
 // Broad phase: a uniform grid and a Verlet neighbour list with a skin.
 //
-//   sort():  counting sort of balls by cell, x fastest. The world reorders its
-//            arrays by the result, so the three cells x-1..x+1 of a grid row
-//            are one contiguous index range and nine ranges cover all 27
-//            neighbouring cells.
+//   sort():  counting sort of balls by cell. The world reorders its arrays by
+//            the result. Cells are numbered x fastest, then y, then z, inside
+//            column blocks kBlockCells wide in x (block slowest): the three
+//            cells x-1..x+1 of a row are then one contiguous index range (two
+//            at a block's edge), so nine to eighteen ranges cover all 27
+//            neighbouring cells, and a ball's neighbours one z-layer away are
+//            one block's layer away in memory, not a whole tank's. A tank at
+//            most kBlockCells wide is one block: plain x, y, z order.
 //   build:   for each ball, every other ball closer than r_i + r_j + skin
 //            (a kernel, Kernels::build_lists). Each ball writes only its own
 //            list, so chunks build in parallel, and lists come out the same
@@ -24,12 +28,20 @@ namespace fishtank {
 
 // What a list build reads and writes: the cell-sorted balls and the grid, and
 // the lists to fill. The build itself is a kernel (kernels.h), scalar or SIMD.
+struct CellCoord {
+  std::int32_t x, y, z;
+};
+
+// Cells per block in x (see sort() above).
+constexpr int kBlockCells = 16;
+
 struct ListBuild {
   const Float4* pos;  // sorted by cell; index n and a few after it are far-away ghosts
   std::uint32_t n;
-  const std::uint32_t* cell_start;  // per cell, its first ball; one extra at the end
-  const std::uint32_t* ball_cell;   // per ball, its cell
-  int nx, ny, nz;                   // cells per axis, x fastest
+  const std::uint32_t* cell_start;  // per cell number, its first ball; one extra at the end
+  const CellCoord* ball_cell;       // per ball, its cell
+  int nx, ny, nz;                   // cells per axis
+  int block;                        // cells per block in x
   float skin;
   std::uint32_t* neighbours;  // out: ball i's list at i * stride, ghost-padded
   std::uint32_t* counts;      // out: the true count, which may exceed stride
@@ -56,17 +68,28 @@ inline std::uint32_t finish_list(const ListBuild& b, std::uint32_t i, std::uint3
 // the end of a cell range, so arrays hold n + kGhostSlots entries.
 constexpr std::uint32_t kGhostSlots = 4;
 
-// Calls visit(j_begin, j_end) for the nine index ranges (three rows of three
-// cells in each of three layers) that hold every ball of ball i's 27 cells.
+// The number of cell (x, y, z) in the sort order.
+inline std::size_t cell_number(int x, int y, int z, int ny, int nz, int block) {
+  const int x_block = x / block;
+  return ((std::size_t(x_block) * nz + z) * ny + y) * block + (x - x_block * block);
+}
+
+// Calls visit(j_begin, j_end) for the index ranges (a row of up to three
+// cells, split where it crosses a block edge, for each of nine rows) that
+// hold every ball of ball i's 27 cells.
 template <class Visit>
 inline void for_each_neighbour_range(const ListBuild& b, std::uint32_t i, Visit visit) {
-  const int cell = static_cast<int>(b.ball_cell[i]);
-  const int cx = cell % b.nx, cy = (cell / b.nx) % b.ny, cz = cell / (b.nx * b.ny);
-  const int x_lo = cx > 0 ? cx - 1 : 0, x_hi = cx + 1 < b.nx ? cx + 1 : b.nx - 1;
-  for (int z = cz > 0 ? cz - 1 : 0; z <= cz + 1 && z < b.nz; ++z) {
-    for (int y = cy > 0 ? cy - 1 : 0; y <= cy + 1 && y < b.ny; ++y) {
-      const std::size_t row = std::size_t(b.nx) * (y + std::size_t(b.ny) * z);
-      visit(b.cell_start[row + x_lo], b.cell_start[row + x_hi + 1]);
+  const CellCoord c = b.ball_cell[i];
+  const int x_lo = c.x > 0 ? c.x - 1 : 0, x_hi = c.x + 1 < b.nx ? c.x + 1 : b.nx - 1;
+  // Where the row splits: the first cell of the second block, or past x_hi.
+  const int split = x_lo / b.block != x_hi / b.block ? x_hi / b.block * b.block : x_hi + 1;
+  for (int z = c.z > 0 ? c.z - 1 : 0; z <= c.z + 1 && z < b.nz; ++z) {
+    for (int y = c.y > 0 ? c.y - 1 : 0; y <= c.y + 1 && y < b.ny; ++y) {
+      visit(b.cell_start[cell_number(x_lo, y, z, b.ny, b.nz, b.block)],
+            b.cell_start[cell_number(split - 1, y, z, b.ny, b.nz, b.block) + 1]);
+      if (split <= x_hi)
+        visit(b.cell_start[cell_number(split, y, z, b.ny, b.nz, b.block)],
+              b.cell_start[cell_number(x_hi, y, z, b.ny, b.nz, b.block) + 1]);
     }
   }
 }
@@ -92,15 +115,17 @@ class NeighbourList {
   const std::uint32_t* counts() const { return counts_.data(); }
 
  private:
-  std::uint32_t cell_of(const Float4& p) const;
+  CellCoord cell_of(const Float4& p) const;
 
   TankBounds tank_;
   float skin_ = 0.0f;
   int nx_ = 1, ny_ = 1, nz_ = 1;
+  int block_ = 1;  // cells per block in x: min(kBlockCells, nx_)
   Vec3 inv_edge_;
-  std::vector<std::uint32_t> cell_start_;   // per cell, first sorted index; one extra at the end
-  std::vector<std::uint32_t> sorted_cell_;  // per sorted ball, its cell
-  std::vector<std::uint32_t> scratch_cell_;
+  std::vector<std::uint32_t> cell_start_;  // per cell number, first sorted index; one extra at the end
+  std::vector<CellCoord> sorted_cell_;     // per sorted ball, its cell
+  std::vector<CellCoord> scratch_cell_;
+  std::vector<std::uint32_t> scratch_number_;
   std::uint32_t stride_ = 0;
   std::vector<std::uint32_t> neighbours_;
   std::vector<std::uint32_t> counts_;

@@ -49,13 +49,17 @@ Lists build(const Kernels& kernels, const TankBounds& tank, const AlignedVector<
 }  // namespace
 
 TEST_CASE("every list build finds the same neighbours as a brute-force search", "[physics][broadphase]") {
+  // 20 units: 6 cells across, one block; 60 units: 18 cells, a full block of
+  // kBlockCells and a part-empty one, so rows split at the block edge.
+  const float width = GENERATE(20.0f, 60.0f);
   TankBounds tank;
-  tank.min = {-10.0f, 0.0f, -10.0f};
-  tank.max = {10.0f, 20.0f, 10.0f};
-  const std::uint32_t n = 3000;
+  tank.min = {-0.5f * width, 0.0f, -10.0f};
+  tank.max = {0.5f * width, 20.0f, 10.0f};
+  const std::uint32_t n = static_cast<std::uint32_t>(150 * width);
+  INFO("tank " << width << " units wide, " << n << " balls");
   const AlignedVector<Float4> balls = random_balls(tank, n);
-  const Lists scalar = build(kScalarKernels, tank, balls, n, 64);
-  REQUIRE(scalar.longest <= 64);
+  const Lists scalar = build(kScalarKernels, tank, balls, n, 96);
+  REQUIRE(scalar.longest <= 96);
 
   // Brute force over the same sorted order: the scalar build is the reference.
   NeighbourList grid;
@@ -80,7 +84,7 @@ TEST_CASE("every list build finds the same neighbours as a brute-force search", 
 
   for (const std::string& name : variant_names()) {
     INFO(name);
-    const Lists simd = build(kernels_named(name), tank, balls, n, 64);
+    const Lists simd = build(kernels_named(name), tank, balls, n, 96);
     CHECK(simd.counts == scalar.counts);
     CHECK(simd.entries == scalar.entries);  // same neighbours in the same order
   }
