@@ -122,8 +122,9 @@ int run_server(const fishtank::ServerOptions& o) {
     next_frame = w.steps() + o.record_every;
   };
   loop.on_status = [&network](const fishtank::World& w, const fishtank::LoopStatus& s) {
-    std::fprintf(stderr, "t = %7.1f s  balls %5u (+%u queued)  %6.0f steps/s  load %5.1f %%  %s%s\n", w.time(),
-                 w.ball_count(), w.pending(), s.steps_per_s, 100.0 * s.load, network.status().c_str(),
+    std::fprintf(stderr, "t = %7.1f s  balls %5u (+%u queued)  %6.0f steps/s  load %5.1f %% on %d thread%s  %s%s\n",
+                 w.time(), w.ball_count(), w.pending(), s.steps_per_s, 100.0 * s.load, s.threads,
+                 s.threads == 1 ? "" : "s", network.status().c_str(),
                  s.dropped_steps ? "  (falling behind real time)" : "");
   };
   fishtank::run_realtime(world, loop, g_stop);

@@ -25,7 +25,7 @@ constexpr std::uint32_t kMinItemsPerThread = 1024;
 
 int WorkerPool::hardware_threads() { return std::max(1u, boost::thread::hardware_concurrency()); }
 
-WorkerPool::WorkerPool(int threads) : thread_count_(std::max(1, threads)) {
+WorkerPool::WorkerPool(int threads) : thread_count_(std::max(1, threads)), active_limit_(thread_count_) {
   for (int t = 1; t < thread_count_; ++t) workers_.emplace_back([this, t] { worker_loop(t); });
 }
 
@@ -39,6 +39,8 @@ WorkerPool::~WorkerPool() {
   for (boost::thread& w : workers_) w.join();
 }
 
+void WorkerPool::set_active_limit(int limit) { active_limit_ = std::clamp(limit, 1, thread_count_); }
+
 void WorkerPool::run_chunk(int thread) {
   if (thread >= active_) return;
   std::uint64_t n = count_;
@@ -48,7 +50,7 @@ void WorkerPool::run_chunk(int thread) {
 }
 
 void WorkerPool::run(std::uint32_t count, const Phase& phase) {
-  const int useful = static_cast<int>(std::min<std::uint32_t>(count / kMinItemsPerThread, thread_count_));
+  const int useful = static_cast<int>(std::min<std::uint32_t>(count / kMinItemsPerThread, active_limit_));
   if (useful <= 1) {
     if (count > 0) phase(0, count, 0);
     return;
@@ -73,6 +75,15 @@ void WorkerPool::run(std::uint32_t count, const Phase& phase) {
   }
 }
 
+void WorkerPool::wake() {
+  if (workers_.empty()) return;
+  {
+    boost::lock_guard<boost::mutex> lock(mutex_);
+    wake_calls_.fetch_add(1, std::memory_order_relaxed);
+  }
+  wake_.notify_all();
+}
+
 void WorkerPool::worker_loop(int thread) {
   enable_flush_denormals_to_zero();
   std::uint64_t seen = 0;
@@ -84,7 +95,12 @@ void WorkerPool::worker_loop(int thread) {
     }
     if (generation_.load(std::memory_order_acquire) == seen) {
       boost::unique_lock<boost::mutex> lock(mutex_);
-      wake_.wait(lock, [&] { return generation_.load(std::memory_order_acquire) != seen; });
+      const std::uint64_t wake_calls = wake_calls_.load(std::memory_order_relaxed);
+      wake_.wait(lock, [&] {
+        return generation_.load(std::memory_order_acquire) != seen ||
+               wake_calls_.load(std::memory_order_relaxed) != wake_calls;
+      });
+      if (generation_.load(std::memory_order_acquire) == seen) continue;  // woken ahead of work: poll again
     }
     seen = generation_.load(std::memory_order_acquire);
     if (stopping_.load()) return;

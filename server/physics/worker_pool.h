@@ -35,7 +35,14 @@ class WorkerPool {
   WorkerPool& operator=(const WorkerPool&) = delete;
 
   int threads() const { return thread_count_; }
+  // Passes use at most this many threads (1..threads()); the others stay idle.
+  void set_active_limit(int limit);
+  int active_limit() const { return active_limit_; }
   void run(std::uint32_t count, const Phase& phase);
+  // Wakes sleeping workers now so that they are polling, not asleep, when a
+  // run() comes within the next millisecond: a paced caller pays the wake-up
+  // while it waits for its next batch instead of inside the batch.
+  void wake();
 
   // The run-time default: one thread per available core.
   static int hardware_threads();
@@ -49,7 +56,9 @@ class WorkerPool {
   const Phase* phase_ = nullptr;
   std::uint32_t count_ = 0;
   int active_ = 1;  // threads given a chunk in the current phase
+  int active_limit_;
   std::atomic<std::uint64_t> generation_{0};
+  std::atomic<std::uint64_t> wake_calls_{0};
   std::atomic<int> pending_{0};
   std::atomic<bool> stopping_{false};
   boost::mutex mutex_;

@@ -72,6 +72,8 @@ class World {
   const Float4* player_positions() const { return player_pos_.data(); }
 
   void step();
+  // Gets the worker threads ready for a step due within a millisecond (see WorkerPool::wake).
+  void wake_workers() { pool_.wake(); }
 
   std::uint32_t ball_count() const { return n_; }
   std::uint32_t pending() const { return spawner_.pending(); }
@@ -86,6 +88,9 @@ class World {
   const ContactModel& model() const { return model_; }
   const Kernels& kernels() const { return kernels_; }
   int threads() const { return pool_.threads(); }
+  // Steps use at most this many of the threads (results do not depend on it).
+  void set_thread_limit(int limit) { pool_.set_active_limit(limit); }
+  int thread_limit() const { return pool_.active_limit(); }
   const PhaseSeconds& phase_seconds() const { return phase_seconds_; }
   double mean_neighbours() const;
 
