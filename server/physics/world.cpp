@@ -234,8 +234,8 @@ void World::start_from_current_state() {
   // The pass needs this step's half-step velocities, which come from a(t):
   // forces from the current positions with v(t) standing in for v(t - dt/2),
   // then the first half kick and the drift for every ball.
-  PhaseTimer timer(phase_seconds_.step_pass);
   if (needs_rebuild_) rebuild();
+  PhaseTimer timer(phase_seconds_.step_pass);
   std::copy(vel_.begin(), vel_.end(), vel_half_.begin());
   StepArrays s = arrays();
   pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int) {
