@@ -52,7 +52,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
                                               "player spheres at most; later clients observe");
 
   po::options_description physics("Physics");
-  physics.add_options()("stiffness", po::value(&o.physics.stiffness)->default_value(defaults.stiffness, "20000"),
+  physics.add_options()("stiffness", po::value(&o.physics.stiffness)->default_value(defaults.stiffness, "25000"),
                         "contact spring constant k, N/m")(
       "restitution", po::value(&o.physics.restitution)->default_value(defaults.restitution, "0.6"),
       "coefficient of restitution e, (0, 1]")("steps-per-contact",

@@ -14,7 +14,7 @@
 namespace fishtank {
 
 struct PhysicsParams {
-  float stiffness = 2.0e4f;        // k, N/m: keeps a full tank's overlap a few % of r_min
+  float stiffness = 2.5e4f;        // k, N/m: keeps a full tank's largest overlap under 10 % of r_min
   float restitution = 0.6f;        // e, measured rebound / approach normal speed
   int steps_per_contact = 20;      // n in dt = t_c / n
   float dt = 0.0f;                 // 0: derive from k; otherwise must be <= t_c / kMinStepsPerContact

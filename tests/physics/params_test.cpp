@@ -21,8 +21,8 @@ TEST_CASE("automatic dt resolves the shortest contact in steps_per_contact steps
   const float t_c = 3.14159265f * std::sqrt(0.5f / p.stiffness);  // two unit masses: m_eff = 0.5
   CHECK(contact_duration(p.stiffness) == Approx(t_c));
   CHECK(derived_dt(p) == Approx(t_c / p.steps_per_contact));
-  // The default tank keeps real time at about 1270 steps per second.
-  CHECK(1.0f / derived_dt(p) == Approx(1273.0f).epsilon(0.01));
+  // The default k = 2.5e4 N/m: t_c = 14.05 ms, about 1420 steps per simulated second.
+  CHECK(1.0f / derived_dt(p) == Approx(1423.5f).epsilon(0.01));
 }
 
 TEST_CASE("defaults are valid", "[params]") { CHECK(validate(PhysicsParams{}).empty()); }
