@@ -9,9 +9,11 @@
 #include <immintrin.h>
 
 #include "common/float4.h"
+#include "common/simd/isa_namespace.h"
 #include "common/simd/sse_float4.h"
 
 namespace fishtank::simd {
+inline namespace FISHTANK_SIMD_ISA_NAMESPACE {
 
 struct M8 {
   __m256 v;
@@ -71,4 +73,5 @@ inline void transpose(F8 a, F8 b, F8 c, F8 d, F8& xs, F8& ys, F8& zs, F8& ws) {
 // The two halves added: eight lanes folded into four.
 inline F4 fold_halves(F8 a) { return {_mm_add_ps(_mm256_castps256_ps128(a.v), _mm256_extractf128_ps(a.v, 1))}; }
 
+}  // namespace FISHTANK_SIMD_ISA_NAMESPACE
 }  // namespace fishtank::simd

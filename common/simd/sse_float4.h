@@ -1,16 +1,19 @@
 #pragma once
 // Thin, explicit wrapper over SSE4.1 intrinsics: four float lanes (F4), a
-// lane mask (M4) and four indices (I4). Only the SSE twins include this; the scalar twins are plain
-// C++. Every operation maps to one or two instructions, so the kernels read as
-// arithmetic while the generated code stays predictable.
+// lane mask (M4) and four indices (I4). Only the SIMD kernels include this;
+// the scalar twins are plain C++. Every operation maps to one or two
+// instructions, so the kernels read as arithmetic while the generated code
+// stays predictable.
 
 #include <smmintrin.h>
 
 #include <cstdint>
 
 #include "common/float4.h"
+#include "common/simd/isa_namespace.h"
 
 namespace fishtank::simd {
+inline namespace FISHTANK_SIMD_ISA_NAMESPACE {
 
 struct M4 {
   __m128 v;
@@ -119,4 +122,5 @@ inline float lane(F4 a, int i) {
   return f[i];
 }
 
+}  // namespace FISHTANK_SIMD_ISA_NAMESPACE
 }  // namespace fishtank::simd
