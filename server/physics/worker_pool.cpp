@@ -76,7 +76,7 @@ void WorkerPool::run(std::uint32_t count, const Phase& phase) {
 }
 
 void WorkerPool::wake() {
-  if (workers_.empty()) return;
+  if (active_limit_ <= 1) return;  // no pass will hand a worker anything
   {
     boost::lock_guard<boost::mutex> lock(mutex_);
     wake_calls_.fetch_add(1, std::memory_order_relaxed);

@@ -163,7 +163,8 @@ void World::spawn() {
     id_[i] = next_id_++;
     energy_added_ += ball_energy(pos_[i], vel_[i], model_.gravity);
     // A spawned ball touches nothing, so gravity is its whole acceleration.
-    next_max_d2_ = std::max(next_max_d2_, kick_drift(i, Float4{0.0f, -model_.gravity, 0.0f, 0.0f}));
+    // (Its distance from a build it was never in means nothing: the lists are rebuilt anyway.)
+    kick_drift(i, Float4{0.0f, -model_.gravity, 0.0f, 0.0f});
   }
   needs_rebuild_ = true;
 }
