@@ -1,5 +1,6 @@
 // Google Benchmark of whole physics steps, so ratios come from one process:
 //   step_tank/<variant>/<threads>  every kernel set on one settled 6000-ball tank
+//   build_lists/<variant>          one neighbour-list build of that tank, one thread
 //   step_wide/sse/<balls>          the wide scene at 10^4, 10^5 and 10^6 balls
 //                                  (SSE on every core), each stepped 50 steps
 //                                  per repetition so all sizes advance through
@@ -16,6 +17,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "common/fp_env.h"
@@ -51,6 +53,23 @@ void step_tank(benchmark::State& state, const fishtank::Kernels& kernels) {
   for (auto _ : state) world.step();
   state.counters["ball_steps_per_s"] =
       benchmark::Counter(double(state.iterations()) * world.ball_count(), benchmark::Counter::kIsRate);
+}
+
+void build_lists(benchmark::State& state, const fishtank::Kernels& kernels) {
+  fishtank::PhysicsParams params;
+  fishtank::AlignedVector<fishtank::Float4> unsorted;
+  for (const fishtank::BallView& b : settled_tank()) unsorted.push_back(b.pos);
+  const auto n = static_cast<std::uint32_t>(unsorted.size());
+  unsorted.resize(n + fishtank::kGhostSlots, fishtank::Float4{1e6f, 1e6f, 1e6f, 0.0f});
+  fishtank::NeighbourList list;
+  list.configure(params.tank, params.skin);
+  std::vector<std::uint32_t> order;
+  list.sort(unsorted.data(), n, order);
+  fishtank::AlignedVector<fishtank::Float4> pos(unsorted);
+  for (std::uint32_t k = 0; k < n; ++k) pos[k] = unsorted[order[k]];
+  list.reserve(n, 32);
+  const fishtank::ListBuild build = list.build_view(pos.data(), n);
+  for (auto _ : state) benchmark::DoNotOptimize(kernels.build_lists(build, 0, n));
 }
 
 // One wide-scene world per size, dropped and run for the scene's 4 simulated
@@ -92,6 +111,13 @@ int main(int argc, char** argv) {
   add("step_tank/scalar", fishtank::kScalarKernels, false);
   add("step_tank/sse", fishtank::kSseKernels, true);
   if (fishtank::cpu_has_avx2()) add("step_tank/avx2", fishtank::kAvx2Kernels, true);
+  for (const fishtank::Kernels* kernels :
+       {&fishtank::kScalarKernels, &fishtank::kSseKernels, &fishtank::kAvx2Kernels}) {
+    if (kernels == &fishtank::kAvx2Kernels && !fishtank::cpu_has_avx2()) continue;
+    benchmark::RegisterBenchmark((std::string("build_lists/") + kernels->variant).c_str(), build_lists,
+                                 std::cref(*kernels))
+        ->Unit(benchmark::kMicrosecond);
+  }
   benchmark::RegisterBenchmark("step_wide/sse", step_wide)
       ->Arg(10000)
       ->Arg(100000)
