@@ -26,15 +26,26 @@ struct F8 {
   static F8 zero() { return {_mm256_setzero_ps()}; }
   // The same four lanes in both halves.
   static F8 both(F4 a) { return {_mm256_set_m128(a.v, a.v)}; }
+  static F8 halves(F4 lo, F4 hi) { return {_mm256_set_m128(hi.v, lo.v)}; }
   // lo in the low half, hi in the high half: two aligned loads.
   static F8 load_pair(const Float4& lo, const Float4& hi) {
     return {_mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(&lo.x)), _mm_load_ps(&hi.x), 1)};
+  }
+  F4 lo() const { return {_mm256_castps256_ps128(v)}; }
+  F4 hi() const { return {_mm256_extractf128_ps(v, 1)}; }
+  // The low half to lo, the high half to hi: two aligned stores.
+  void store_pair(Float4& lo_out, Float4& hi_out) const {
+    _mm_store_ps(&lo_out.x, lo().v);
+    _mm_store_ps(&hi_out.x, hi().v);
   }
 };
 
 inline F8 operator+(F8 a, F8 b) { return {_mm256_add_ps(a.v, b.v)}; }
 inline F8 operator-(F8 a, F8 b) { return {_mm256_sub_ps(a.v, b.v)}; }
 inline F8 operator*(F8 a, F8 b) { return {_mm256_mul_ps(a.v, b.v)}; }
+inline F8 operator/(F8 a, F8 b) { return {_mm256_div_ps(a.v, b.v)}; }
+inline F8& operator+=(F8& a, F8 b) { return a = a + b; }
+inline F8 sqrt(F8 a) { return {_mm256_sqrt_ps(a.v)}; }
 // a * b + c in one rounding.
 inline F8 mul_add(F8 a, F8 b, F8 c) { return {_mm256_fmadd_ps(a.v, b.v, c.v)}; }
 // c - a * b in one rounding.
@@ -47,9 +58,17 @@ inline F8 rsqrt(F8 a) {
 }
 inline F8 max(F8 a, F8 b) { return {_mm256_max_ps(a.v, b.v)}; }
 inline M8 operator<(F8 a, F8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_LT_OQ)}; }
+inline M8 operator>(F8 a, F8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_GT_OQ)}; }
+inline M8 operator|(M8 a, M8 b) { return {_mm256_or_ps(a.v, b.v)}; }
 inline bool any(M8 m) { return _mm256_movemask_ps(m.v) != 0; }
 // Lanes where the mask is off become zero.
 inline F8 keep(M8 m, F8 a) { return {_mm256_and_ps(m.v, a.v)}; }
+
+// Zero the w lane of each half.
+inline F8 xyz_only(F8 a) { return {_mm256_blend_ps(a.v, _mm256_setzero_ps(), 0b10001000)}; }
+
+// Dot product of the x, y, z lanes of each half, broadcast across that half.
+inline F8 dot3(F8 a, F8 b) { return {_mm256_dp_ps(a.v, b.v, 0x7F)}; }
 
 // Lane L of each half, broadcast across that half (the same value in both
 // halves when a came from F8::both).
@@ -70,8 +89,12 @@ inline void transpose(F8 a, F8 b, F8 c, F8 d, F8& xs, F8& ys, F8& zs, F8& ws) {
   ws.v = _mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(3, 2, 3, 2));
 }
 
-// The two halves added: eight lanes folded into four.
-inline F4 fold_halves(F8 a) { return {_mm_add_ps(_mm256_castps256_ps128(a.v), _mm256_extractf128_ps(a.v, 1))}; }
+// Per half, the sum of its four lanes of each input, packed as (sum x, sum y, sum z, 0).
+inline F8 sum_lanes_xyz(F8 xs, F8 ys, F8 zs) {
+  __m256 t0 = _mm256_hadd_ps(xs.v, ys.v);                 // x01 x23 y01 y23, per half
+  __m256 t1 = _mm256_hadd_ps(zs.v, _mm256_setzero_ps());  // z01 z23 0 0
+  return {_mm256_hadd_ps(t0, t1)};                        // x y z 0
+}
 
 }  // namespace FISHTANK_SIMD_ISA_NAMESPACE
 }  // namespace fishtank::simd

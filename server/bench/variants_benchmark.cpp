@@ -50,9 +50,17 @@ void step_tank(benchmark::State& state, const fishtank::Kernels& kernels) {
   for (const fishtank::BallView& b : settled_tank())
     world.place_ball(b.kind, {b.pos.x, b.pos.y, b.pos.z}, {b.vel.x, b.vel.y, b.vel.z});
   for (int s = 0; s < 50; ++s) world.step();  // first lists, warm caches
+  const std::uint64_t rebuilds_before = world.rebuilds();
+  const fishtank::PhaseSeconds phases_before = world.phase_seconds();
   for (auto _ : state) world.step();
   state.counters["ball_steps_per_s"] =
       benchmark::Counter(double(state.iterations()) * world.ball_count(), benchmark::Counter::kIsRate);
+  // How much of the time went to neighbour-list rebuilds, which the settled
+  // state's rattling balls trigger (a rebuild costs several steps).
+  const fishtank::PhaseSeconds& phases = world.phase_seconds();
+  const double rebuild_seconds = phases.neighbours - phases_before.neighbours;
+  state.counters["rebuilds_per_kstep"] = 1000.0 * double(world.rebuilds() - rebuilds_before) / state.iterations();
+  state.counters["rebuild_share"] = rebuild_seconds / (rebuild_seconds + phases.step_pass - phases_before.step_pass);
 }
 
 void build_lists(benchmark::State& state, const fishtank::Kernels& kernels) {
@@ -94,9 +102,17 @@ World& wide_world(std::uint32_t balls) {
 void step_wide(benchmark::State& state) {
   fishtank::enable_flush_denormals_to_zero();
   World& world = wide_world(static_cast<std::uint32_t>(state.range(0)));
+  const std::uint64_t rebuilds_before = world.rebuilds();
+  const fishtank::PhaseSeconds phases_before = world.phase_seconds();
   for (auto _ : state) world.step();
   state.counters["ball_steps_per_s"] =
       benchmark::Counter(double(state.iterations()) * world.ball_count(), benchmark::Counter::kIsRate);
+  // How much of the time went to neighbour-list rebuilds, which the settled
+  // state's rattling balls trigger (a rebuild costs several steps).
+  const fishtank::PhaseSeconds& phases = world.phase_seconds();
+  const double rebuild_seconds = phases.neighbours - phases_before.neighbours;
+  state.counters["rebuilds_per_kstep"] = 1000.0 * double(world.rebuilds() - rebuilds_before) / state.iterations();
+  state.counters["rebuild_share"] = rebuild_seconds / (rebuild_seconds + phases.step_pass - phases_before.step_pass);
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 // build (two balls closing by skin / 2 each could then touch unseen); the
 // world checks that every step and rebuilds only then, as LAMMPS does.
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -48,19 +49,20 @@ struct ListBuild {
   std::uint32_t stride;
 };
 
-// Lists are padded with the ghost's index to a multiple of the widest
-// kernel's lanes; a narrower kernel reads a shorter prefix.
-constexpr std::uint32_t kListPadding = 8;
+// Strides are a multiple of the four neighbours a SIMD kernel takes per ball
+// and block, and the rest of each ball's row holds the ghost's index, so a
+// kernel reads whole blocks with no tail loop, and the AVX2 kernel, which
+// walks two balls' rows side by side, reads ghosts where the shorter one ends.
+constexpr std::uint32_t kListPadding = 4;
 inline std::uint32_t padded_neighbour_count(std::uint32_t count, std::uint32_t lanes) {
   return (count + lanes - 1) / lanes * lanes;
 }
 
-// Ball i's count neighbours are in place: record the count and pad with the ghost.
+// Ball i's count neighbours are in place: record the count and fill the row with the ghost.
 inline std::uint32_t finish_list(const ListBuild& b, std::uint32_t i, std::uint32_t count) {
   b.counts[i] = count;
   std::uint32_t* list = b.neighbours + std::size_t(i) * b.stride;
-  const std::uint32_t padded = padded_neighbour_count(count, kListPadding);
-  for (std::uint32_t k = count; k < padded && k < b.stride; ++k) list[k] = b.n;
+  std::fill(list + std::min(count, b.stride), list + b.stride, b.n);
   return count;
 }
 

@@ -3,7 +3,7 @@
 // twins with the same signatures:
 //   kernels_scalar.cpp  plain C++, one pair at a time (the reference)
 //   kernels_sse.cpp     SSE4.1, four neighbours at a time
-//   kernels_avx2.cpp    AVX2 + FMA, eight neighbours at a time (a third level)
+//   kernels_avx2.cpp    AVX2 + FMA, two balls and four neighbours of each at a time (a third level)
 // The two SIMD files share their per-ball code (kernels_simd_ball.h).
 // A build picks one set at compile time (see server/main.cpp); the tests hold
 // them all so they can compare them.
@@ -32,8 +32,8 @@ struct StepArrays {
   Float4* vel_half_next;   // out: velocity half a step later
   const Float4* pos_at_build;
   // Full neighbour list (each pair appears from both sides): ball i's
-  // neighbours are neighbours[i * stride, i * stride + count[i]), followed by
-  // ghost indices up to a multiple of kListPadding so SIMD loads need no tail loop.
+  // neighbours are neighbours[i * stride, i * stride + count[i]), and the rest
+  // of the row holds a ghost's index (broadphase.h, finish_list).
   const std::uint32_t* neighbours;
   const std::uint32_t* neighbour_count;
   std::uint32_t stride;
@@ -45,7 +45,6 @@ struct StepArrays {
 struct Kernels {
   const char* variant;  // "scalar", "sse" or "avx2"
   const char* simd;     // instruction set of the kernels
-  int lanes;            // neighbours per SIMD block (1 for scalar)
   bool threaded;        // whether the build may use more than one thread
   // The step for balls [begin, end). Returns the largest squared distance of
   // pos_next from pos_at_build, which tells when the lists must be rebuilt.

@@ -1,13 +1,17 @@
-// AVX2 + FMA level of the step kernels: the SSE neighbour loop of
-// kernels_sse.cpp widened to eight neighbours per block. See kernels.h for the
-// passes and kernels_scalar.cpp for the same arithmetic one pair at a time.
+// AVX2 + FMA level of the step kernels: two balls per 256-bit vector, one in
+// each 128-bit half. See kernels.h for the passes and kernels_scalar.cpp for
+// the same arithmetic one pair at a time.
 //
-// A settled ball has 7.5 listed neighbours, so most lists are one block of
-// eight instead of two or three blocks of four: fewer transposes, fewer
-// Newton steps, less padding. Neighbours j0..j3 sit in the low half of each
-// register and j4..j7 in the high half (see common/simd/avx_float8.h); the
-// arithmetic is the SSE kernel's, with multiply-adds fused, so states agree
-// with the other variants to float rounding, not bit for bit.
+// Each half does what the SSE kernel of kernels_sse.cpp does for one ball:
+// four of its neighbours per block, loaded, transposed and computed at once.
+// A block therefore covers four neighbours of ball a and four of ball b, and
+// the per-ball work around the neighbour loop (loads, walls, kick, drift,
+// stores, the sum over lanes) is done for two balls per instruction, which is
+// where the SSE kernel spends about a third of its instructions. A ball has
+// 7.5 neighbours on average, so the pairs' blocks are about as well filled as
+// blocks of eight neighbours of one ball. The arithmetic is the SSE kernel's,
+// with multiply-adds fused, so states agree with the other variants to float
+// rounding, not bit for bit.
 
 #include "common/simd/avx_float8.h"
 #include "server/physics/kernels_simd_ball.h"
@@ -18,36 +22,53 @@ namespace {
 using simd::F8;
 using simd::M8;
 
-// Sum over ball i's neighbours of the spring-dashpot force, as (Fx, Fy, Fz, 0).
-[[gnu::always_inline]] inline F4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t i, F4 pi4,
-                                             F4 vi4) {
+template <>
+struct BallLanes<F8> {
+  static constexpr std::uint32_t kBalls = 2;
+  static F8 both(F4 a) { return F8::both(a); }
+  static F8 load(const Float4* a, std::uint32_t first, std::uint32_t last) { return F8::load_pair(a[first], a[last]); }
+  static void store(F8 v, Float4* a, std::uint32_t first, std::uint32_t last) { v.store_pair(a[first], a[last]); }
+  template <class PerBall>
+  static F8 each_ball(PerBall f, F8 p, F8 v) {
+    return F8::halves(f(p.lo(), v.lo()), f(p.hi(), v.hi()));
+  }
+  static float lane0_max(F8 a) { return simd::lane(max(a.lo(), a.hi()), 0); }
+};
+
+// Sum over the neighbours of balls a (low half of p, v) and b (high half) of
+// the spring-dashpot force, as (Fx, Fy, Fz, 0) in each half.
+[[gnu::always_inline]] inline F8 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t a,
+                                             std::uint32_t b, F8 p, F8 v) {
   // As in the SSE kernel, rows are subtracted before the transpose:
-  // pi - pos[j] is (dx, dy, dz, ri - rj), vi - vel[j] is (dvx, dvy, dvz, mi - mj).
-  const F8 pi = F8::both(pi4), vi = F8::both(vi4);
-  const F8 two_ri = simd::broadcast<3>(pi) + simd::broadcast<3>(pi);
-  const F8 mi = simd::broadcast<3>(vi);
+  // p - pos[j] is (dx, dy, dz, ri - rj), v - vel[j] is (dvx, dvy, dvz, mi - mj).
+  const F8 two_ri = simd::broadcast<3>(p) + simd::broadcast<3>(p);
+  const F8 mi = simd::broadcast<3>(v);
   const F8 k = F8::splat(m.k), damping = F8::splat(m.damping_factor);
   const F8 tiny = F8::splat(1e-12f);  // squared distance floor: coincident centres stay finite
 
+  // Past its end, the shorter list's row holds ghosts: they touch nothing.
+  const std::uint32_t* list_a = s.neighbours + std::size_t(a) * s.stride;
+  const std::uint32_t* list_b = s.neighbours + std::size_t(b) * s.stride;
+  const std::uint32_t count = padded_neighbour_count(std::max(s.neighbour_count[a], s.neighbour_count[b]), 4);
+
   F8 fx = F8::zero(), fy = F8::zero(), fz = F8::zero();
-  const std::uint32_t* list = s.neighbours + std::size_t(i) * s.stride;
-  const std::uint32_t count = padded_neighbour_count(s.neighbour_count[i], 8);
-  for (std::uint32_t n = 0; n < count; n += 8) {
-    const std::uint32_t* j = list + n;
+  for (std::uint32_t n = 0; n < count; n += 4) {
+    const std::uint32_t* ja = list_a + n;
+    const std::uint32_t* jb = list_b + n;
     F8 dx, dy, dz, ri_minus_rj;
-    simd::transpose(pi - F8::load_pair(s.pos[j[0]], s.pos[j[4]]), pi - F8::load_pair(s.pos[j[1]], s.pos[j[5]]),
-                    pi - F8::load_pair(s.pos[j[2]], s.pos[j[6]]), pi - F8::load_pair(s.pos[j[3]], s.pos[j[7]]), dx, dy,
-                    dz, ri_minus_rj);
+    simd::transpose(p - F8::load_pair(s.pos[ja[0]], s.pos[jb[0]]), p - F8::load_pair(s.pos[ja[1]], s.pos[jb[1]]),
+                    p - F8::load_pair(s.pos[ja[2]], s.pos[jb[2]]), p - F8::load_pair(s.pos[ja[3]], s.pos[jb[3]]), dx,
+                    dy, dz, ri_minus_rj);
     F8 d2 = mul_add(dz, dz, mul_add(dy, dy, dx * dx));
     F8 reach = two_ri - ri_minus_rj;  // ri + rj
     M8 touching = d2 < reach * reach;
     if (!simd::any(touching)) continue;
 
     F8 dvx, dvy, dvz, mi_minus_mj;
-    simd::transpose(vi - F8::load_pair(s.vel_half[j[0]], s.vel_half[j[4]]),
-                    vi - F8::load_pair(s.vel_half[j[1]], s.vel_half[j[5]]),
-                    vi - F8::load_pair(s.vel_half[j[2]], s.vel_half[j[6]]),
-                    vi - F8::load_pair(s.vel_half[j[3]], s.vel_half[j[7]]), dvx, dvy, dvz, mi_minus_mj);
+    simd::transpose(v - F8::load_pair(s.vel_half[ja[0]], s.vel_half[jb[0]]),
+                    v - F8::load_pair(s.vel_half[ja[1]], s.vel_half[jb[1]]),
+                    v - F8::load_pair(s.vel_half[ja[2]], s.vel_half[jb[2]]),
+                    v - F8::load_pair(s.vel_half[ja[3]], s.vel_half[jb[3]]), dvx, dvy, dvz, mi_minus_mj);
     F8 inv_dist = simd::rsqrt(max(d2, tiny));
     F8 dist = d2 * inv_dist;
     F8 v_n_dist = mul_add(dvz, dz, mul_add(dvy, dy, dvx * dx));  // v_n |d|
@@ -61,11 +82,12 @@ using simd::M8;
     fy = mul_add(f_over_dist, dy, fy);
     fz = mul_add(f_over_dist, dz, fz);
   }
-  return simd::sum_lanes_xyz(fold_halves(fx), fold_halves(fy), fold_halves(fz));
+  return simd::sum_lanes_xyz(fx, fy, fz);
 }
 
 }  // namespace
 
-const Kernels kAvx2Kernels{"avx2", "avx2+fma", 8, true, step<pair_forces>, accelerations<pair_forces>, build_lists};
+const Kernels kAvx2Kernels{"avx2",     "avx2+fma", true, step<F8, pair_forces>, accelerations<F8, pair_forces>,
+                           build_lists};
 
 }  // namespace fishtank

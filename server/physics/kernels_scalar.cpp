@@ -119,6 +119,6 @@ std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t
 
 }  // namespace
 
-const Kernels kScalarKernels{"scalar", "none", 1, false, step, accelerations, build_lists};
+const Kernels kScalarKernels{"scalar", "none", false, step, accelerations, build_lists};
 
 }  // namespace fishtank

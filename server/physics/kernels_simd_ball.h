@@ -1,8 +1,12 @@
 #pragma once
-// The parts of the SIMD kernels that work on one ball at a time in four lanes:
-// walls, player spheres, the step pass around a neighbour loop that each
-// kernel file supplies (4 lanes in kernels_sse.cpp, 8 in kernels_avx2.cpp),
-// and the neighbour-list build.
+// The parts of the SIMD kernels that work per ball: walls, player spheres,
+// the step pass around a neighbour loop that each kernel file supplies, and
+// the neighbour-list build.
+//
+// A vector V carries one ball in four lanes (F4, kernels_sse.cpp) or two
+// balls, one per 128-bit half (F8, kernels_avx2.cpp); BallLanes<V> says how
+// to load and store them. The per-ball arithmetic (walls, kick, drift) then
+// serves two balls per instruction in the AVX2 kernels.
 //
 // Both files include this header and are compiled with different -m flags, so
 // everything here has internal linkage: each gets its own copy in its own
@@ -18,6 +22,25 @@ namespace {
 
 using simd::F4;
 using simd::M4;
+
+// How a vector type holds balls. A pass visits balls first..last together
+// (last == first when a chunk's last ball has no partner: it is then carried
+// twice and stored twice, with the same result).
+template <class V>
+struct BallLanes;
+
+template <>
+struct BallLanes<F4> {
+  static constexpr std::uint32_t kBalls = 1;
+  static F4 both(F4 a) { return a; }
+  static F4 load(const Float4* a, std::uint32_t first, std::uint32_t) { return F4::load(a[first]); }
+  static void store(F4 v, Float4* a, std::uint32_t first, std::uint32_t) { v.store(a[first]); }
+  template <class PerBall>
+  static F4 each_ball(PerBall f, F4 p, F4 v) {
+    return f(p, v);
+  }
+  static float lane0_max(F4 a) { return simd::lane(a, 0); }  // lane 0, the largest over the balls carried
+};
 
 // Kinematic player spheres: the ball's effective mass is its own mass.
 inline F4 player_forces(const StepArrays& s, const ContactModel& m, F4 pi, F4 vi) {
@@ -40,64 +63,81 @@ inline F4 player_forces(const StepArrays& s, const ContactModel& m, F4 pi, F4 vi
 // Six half-space walls, one lane per axis: below the minimum face the force
 // points +axis, above the maximum face -axis; both grow with depth. The w
 // lanes of the faces are chosen so the w lane never registers a contact.
+template <class V>
 struct Walls {
-  F4 lo, hi;
+  V lo, hi;
   explicit Walls(const TankBounds& t)
-      : lo(F4::set(t.min.x, t.min.y, t.min.z, -1e30f)), hi(F4::set(t.max.x, t.max.y, t.max.z, 1e30f)) {}
+      : lo(BallLanes<V>::both(F4::set(t.min.x, t.min.y, t.min.z, -1e30f))),
+        hi(BallLanes<V>::both(F4::set(t.max.x, t.max.y, t.max.z, 1e30f))) {}
 };
 
-inline F4 wall_forces(const ContactModel& m, const Walls& walls, F4 pi, F4 vi) {
-  const F4 r = simd::broadcast<3>(pi);
-  const F4 below = walls.lo + r - pi;
-  const F4 above = pi + r - walls.hi;
-  const M4 in_floor_or_wall = below > F4::zero(), in_ceiling_or_wall = above > F4::zero();
-  if (!simd::any(in_floor_or_wall | in_ceiling_or_wall)) return F4::zero();  // most balls touch no wall
-  const F4 k = F4::splat(m.k);
-  const F4 c = F4::splat(m.damping_factor) * sqrt(simd::broadcast<3>(vi));
-  const F4 v = simd::xyz_only(vi);
+template <class V>
+inline V wall_forces(const ContactModel& m, const Walls<V>& walls, V pi, V vi) {
+  const V r = simd::broadcast<3>(pi);
+  const V below = walls.lo + r - pi;
+  const V above = pi + r - walls.hi;
+  const auto in_floor_or_wall = below > V::zero(), in_ceiling_or_wall = above > V::zero();
+  if (!simd::any(in_floor_or_wall | in_ceiling_or_wall)) return V::zero();  // most balls touch no wall
+  const V k = V::splat(m.k);
+  const V c = V::splat(m.damping_factor) * sqrt(simd::broadcast<3>(vi));
+  const V v = simd::xyz_only(vi);
   return keep(in_floor_or_wall, k * below - c * v) - keep(in_ceiling_or_wall, k * above + c * v);
 }
 
-// PairForces(s, m, i, p_i, v_i) sums the spring-dashpot forces of ball i's neighbours as (Fx, Fy, Fz, 0).
-using PairForcesFn = F4 (*)(const StepArrays&, const ContactModel&, std::uint32_t, F4, F4);
+// PairForces(s, m, first, last, p, v) sums the spring-dashpot forces of the
+// neighbours of the balls in p (positions) and v (half-step velocities), as
+// (Fx, Fy, Fz, 0) per ball.
+template <class V>
+using PairForcesFn = V (*)(const StepArrays&, const ContactModel&, std::uint32_t, std::uint32_t, V, V);
 
-// a = F / m + g for ball i at position pi with half-step velocity vi. Inlined
-// into the ball loops so the contact constants stay in registers across balls.
-template <PairForcesFn PairForces>
-[[gnu::always_inline]] inline F4 acceleration(const StepArrays& s, const ContactModel& m, const Walls& walls,
-                                              std::uint32_t i, F4 pi, F4 vi) {
-  F4 force = PairForces(s, m, i, pi, vi) + wall_forces(m, walls, pi, vi);
-  if (s.players > 0) force += player_forces(s, m, pi, vi);
-  return force / simd::broadcast<3>(vi) + F4::set(0.0f, -m.gravity, 0.0f, 0.0f);  // force.w == 0, so a.w == 0
+// a = F / m + g for the balls first..last. Inlined into the ball loops so the
+// contact constants stay in registers across balls.
+template <class V, PairForcesFn<V> PairForces>
+[[gnu::always_inline]] inline V acceleration(const StepArrays& s, const ContactModel& m, const Walls<V>& walls,
+                                             std::uint32_t first, std::uint32_t last, V p, V v) {
+  V force = PairForces(s, m, first, last, p, v) + wall_forces(m, walls, p, v);
+  if (s.players > 0) force += BallLanes<V>::each_ball([&](F4 pi, F4 vi) { return player_forces(s, m, pi, vi); }, p, v);
+  // force.w == 0, so a.w == 0
+  return force / simd::broadcast<3>(v) + BallLanes<V>::both(F4::set(0.0f, -m.gravity, 0.0f, 0.0f));
 }
 
-template <PairForcesFn PairForces>
-float step(const StepArrays& s, const ContactModel& m, std::uint32_t begin, std::uint32_t end) {
-  const F4 half_dt = F4::splat(m.half_dt);
-  const F4 dt_xyz = F4::set(m.dt, m.dt, m.dt, 0.0f);  // keeps the radius in w
-  const Walls walls(m.tank);
-  F4 max_d2 = F4::zero();
-  for (std::uint32_t i = begin; i < end; ++i) {
-    const F4 pi = F4::load(s.pos[i]);
-    const F4 vi = F4::load(s.vel_half[i]);
-    const F4 a = acceleration<PairForces>(s, m, walls, i, pi, vi);
-    const F4 v = vi + a * half_dt;
-    const F4 vh_next = v + a * half_dt;
-    const F4 p_next = pi + vh_next * dt_xyz;
-    v.store(s.vel[i]);
-    vh_next.store(s.vel_half_next[i]);
-    p_next.store(s.pos_next[i]);
-    const F4 d = p_next - F4::load(s.pos_at_build[i]);  // w lanes are both the radius
+template <class V, PairForcesFn<V> PairForces>
+float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t begin, std::uint32_t end) {
+  using Lanes = BallLanes<V>;
+  // Local copies: stores through the output pointers cannot change them, so
+  // pointers and constants stay in registers instead of being reloaded per ball.
+  const StepArrays s = arrays;
+  const ContactModel m = model;
+  const V half_dt = V::splat(m.half_dt);
+  const V dt_xyz = Lanes::both(F4::set(m.dt, m.dt, m.dt, 0.0f));  // keeps the radius in w
+  const Walls<V> walls(m.tank);
+  V max_d2 = V::zero();
+  for (std::uint32_t first = begin; first < end; first += Lanes::kBalls) {
+    const std::uint32_t last = std::min(first + Lanes::kBalls, end) - 1;
+    const V p = Lanes::load(s.pos, first, last);
+    const V vh = Lanes::load(s.vel_half, first, last);
+    const V a = acceleration<V, PairForces>(s, m, walls, first, last, p, vh);
+    const V v = vh + a * half_dt;
+    const V vh_next = v + a * half_dt;
+    const V p_next = p + vh_next * dt_xyz;
+    Lanes::store(v, s.vel, first, last);
+    Lanes::store(vh_next, s.vel_half_next, first, last);
+    Lanes::store(p_next, s.pos_next, first, last);
+    const V d = p_next - Lanes::load(s.pos_at_build, first, last);  // w lanes are both the radius
     max_d2 = max(max_d2, dot3(d, d));
   }
-  return simd::lane(max_d2, 0);
+  return Lanes::lane0_max(max_d2);
 }
 
-template <PairForcesFn PairForces>
+template <class V, PairForcesFn<V> PairForces>
 void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin, std::uint32_t end) {
-  const Walls walls(m.tank);
-  for (std::uint32_t i = begin; i < end; ++i)
-    acceleration<PairForces>(s, m, walls, i, F4::load(s.pos[i]), F4::load(s.vel_half[i])).store(acc[i]);
+  using Lanes = BallLanes<V>;
+  const Walls<V> walls(m.tank);
+  for (std::uint32_t first = begin; first < end; first += Lanes::kBalls) {
+    const std::uint32_t last = std::min(first + Lanes::kBalls, end) - 1;
+    const V p = Lanes::load(s.pos, first, last), v = Lanes::load(s.vel_half, first, last);
+    Lanes::store(acceleration<V, PairForces>(s, m, walls, first, last, p, v), acc, first, last);
+  }
 }
 
 // Lists four candidates at a time: a cell range is contiguous in the sorted

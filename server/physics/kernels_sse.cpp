@@ -15,8 +15,8 @@ namespace fishtank {
 namespace {
 
 // Sum over ball i's neighbours of the spring-dashpot force, as (Fx, Fy, Fz, 0).
-[[gnu::always_inline]] inline F4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t i, F4 pi,
-                                             F4 vi) {
+[[gnu::always_inline]] inline F4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t i,
+                                             std::uint32_t /*last: i, one ball per vector*/, F4 pi, F4 vi) {
   // Differences are taken on whole rows before the transpose: pi - pos[j] is
   // (dx, dy, dz, ri - rj) and vi - vel[j] is (dvx, dvy, dvz, mi - mj). That
   // keeps only pi, vi and two broadcasts live instead of eight, so SSE's 16
@@ -60,6 +60,6 @@ namespace {
 
 }  // namespace
 
-const Kernels kSseKernels{"sse", "sse4.1", 4, true, step<pair_forces>, accelerations<pair_forces>, build_lists};
+const Kernels kSseKernels{"sse", "sse4.1", true, step<F4, pair_forces>, accelerations<F4, pair_forces>, build_lists};
 
 }  // namespace fishtank
