@@ -35,7 +35,10 @@ const std::vector<fishtank::BallView>& settled_tank() {
     fishtank::SceneSpec spec;  // tank, 6000 balls
     World world(fishtank::PhysicsParams{}, fishtank::kSseKernels, fishtank::WorkerPool::hardware_threads(), 1);
     fishtank::populate(world, spec);
-    fishtank::settle(world, spec);
+    const fishtank::SettleReport report = fishtank::settle(world, spec);
+    // scripts/callgrind-step switches instrumentation on at this line.
+    std::fprintf(stderr, "settled: %u balls, %.1f simulated s, %s\n", world.ball_count(), report.sim_seconds,
+                 report.settled ? "at rest" : "time limit reached");
     std::vector<fishtank::BallView> state;
     for (std::uint32_t id = 0; id < world.ball_count(); ++id) state.push_back(world.ball(id));
     return state;

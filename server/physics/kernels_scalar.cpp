@@ -74,7 +74,11 @@ inline float wall_force_1d(const ContactModel& m, float pos, float vel, float r,
   return Float4{fx / vi.w, fy / vi.w - m.gravity, fz / vi.w, 0.0f};
 }
 
-float step(const StepArrays& s, const ContactModel& m, std::uint32_t begin, std::uint32_t end) {
+float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t begin, std::uint32_t end) {
+  // Local copies: stores through the output pointers cannot change them, so
+  // pointers and constants stay in registers instead of being reloaded per ball.
+  const StepArrays s = arrays;
+  const ContactModel m = model;
   float max_d2 = 0.0f;
   for (std::uint32_t i = begin; i < end; ++i) {
     const Float4 a = acceleration(s, m, i);
