@@ -25,13 +25,11 @@ inline float wall_force_1d(const ContactModel& m, float pos, float vel, float r,
   return f;
 }
 
-// a = F / m + g for ball i, from this step's positions and half-step velocities.
-// Inlined into the ball loops so the contact constants stay in registers.
-[[gnu::always_inline]] inline Float4 acceleration(const StepArrays& s, const ContactModel& m, std::uint32_t i) {
+// Sum of the spring-dashpot forces of ball i's neighbours, (Fx, Fy, Fz, 0).
+[[gnu::always_inline]] inline Float4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t i) {
   const Float4 pi = s.pos[i];
   const Float4 vi = s.vel_half[i];
   float fx = 0.0f, fy = 0.0f, fz = 0.0f;
-
   const std::uint32_t* list = s.neighbours + std::size_t(i) * s.stride;
   for (std::uint32_t n = 0; n < s.neighbour_count[i]; ++n) {
     const Float4& pj = s.pos[list[n]];
@@ -50,6 +48,16 @@ inline float wall_force_1d(const ContactModel& m, float pos, float vel, float r,
     fy += f * ny;
     fz += f * nz;
   }
+  return Float4{fx, fy, fz, 0.0f};
+}
+
+// a = F / m + g for ball i, given the sum of its neighbours' forces: adds
+// player spheres and walls.
+[[gnu::always_inline]] inline Float4 acceleration(const StepArrays& s, const ContactModel& m, std::uint32_t i,
+                                                  const Float4& pair_force) {
+  const Float4 pi = s.pos[i];
+  const Float4 vi = s.vel_half[i];
+  float fx = pair_force.x, fy = pair_force.y, fz = pair_force.z;
 
   for (int p = 0; p < s.players; ++p) {
     const Float4& pp = s.player_pos[p];
@@ -80,24 +88,32 @@ float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
   const StepArrays s = arrays;
   const ContactModel m = model;
   float max_d2 = 0.0f;
-  for (std::uint32_t i = begin; i < end; ++i) {
-    const Float4 a = acceleration(s, m, i);
-    const Float4 p = s.pos[i], vh = s.vel_half[i];
-    const Float4 v{vh.x + a.x * m.half_dt, vh.y + a.y * m.half_dt, vh.z + a.z * m.half_dt, vh.w};
-    const Float4 vh_next{v.x + a.x * m.half_dt, v.y + a.y * m.half_dt, v.z + a.z * m.half_dt, v.w};
-    const Float4 p_next{p.x + vh_next.x * m.dt, p.y + vh_next.y * m.dt, p.z + vh_next.z * m.dt, p.w};
-    s.vel[i] = v;
-    s.vel_half_next[i] = vh_next;
-    s.pos_next[i] = p_next;
-    const Float4& b = s.pos_at_build[i];
-    float dx = p_next.x - b.x, dy = p_next.y - b.y, dz = p_next.z - b.z;
-    max_d2 = std::max(max_d2, dx * dx + dy * dy + dz * dz);
+  // Batches of balls, as in the SIMD kernels (kernels_simd_ball.h): first the
+  // neighbour sums of the batch, then the rest for each ball.
+  constexpr std::uint32_t kBatch = 64;
+  Float4 pair_force[kBatch];
+  for (std::uint32_t batch = begin; batch < end; batch += kBatch) {
+    const std::uint32_t batch_end = std::min(end, batch + kBatch);
+    for (std::uint32_t i = batch; i < batch_end; ++i) pair_force[i - batch] = pair_forces(s, m, i);
+    for (std::uint32_t i = batch; i < batch_end; ++i) {
+      const Float4 a = acceleration(s, m, i, pair_force[i - batch]);
+      const Float4 p = s.pos[i], vh = s.vel_half[i];
+      const Float4 v{vh.x + a.x * m.half_dt, vh.y + a.y * m.half_dt, vh.z + a.z * m.half_dt, vh.w};
+      const Float4 vh_next{v.x + a.x * m.half_dt, v.y + a.y * m.half_dt, v.z + a.z * m.half_dt, v.w};
+      const Float4 p_next{p.x + vh_next.x * m.dt, p.y + vh_next.y * m.dt, p.z + vh_next.z * m.dt, p.w};
+      s.vel[i] = v;
+      s.vel_half_next[i] = vh_next;
+      s.pos_next[i] = p_next;
+      const Float4& b = s.pos_at_build[i];
+      float dx = p_next.x - b.x, dy = p_next.y - b.y, dz = p_next.z - b.z;
+      max_d2 = std::max(max_d2, dx * dx + dy * dy + dz * dz);
+    }
   }
   return max_d2;
 }
 
 void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin, std::uint32_t end) {
-  for (std::uint32_t i = begin; i < end; ++i) acc[i] = acceleration(s, m, i);
+  for (std::uint32_t i = begin; i < end; ++i) acc[i] = acceleration(s, m, i, pair_forces(s, m, i));
 }
 
 std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t end) {
