@@ -46,6 +46,21 @@ const std::vector<fishtank::BallView>& settled_tank() {
   return balls;
 }
 
+// The timed loop of a step benchmark: the rate, and how often the lists were
+// rebuilt while it ran and what share of the time that took (a rebuild costs
+// several steps, and how often one is due depends on the scene).
+void time_steps(benchmark::State& state, World& world) {
+  const std::uint64_t rebuilds_before = world.rebuilds();
+  const fishtank::PhaseSeconds phases_before = world.phase_seconds();
+  for (auto _ : state) world.step();
+  state.counters["ball_steps_per_s"] =
+      benchmark::Counter(double(state.iterations()) * world.ball_count(), benchmark::Counter::kIsRate);
+  const fishtank::PhaseSeconds& phases = world.phase_seconds();
+  const double rebuild_seconds = phases.neighbours - phases_before.neighbours;
+  state.counters["rebuilds_per_kstep"] = 1000.0 * double(world.rebuilds() - rebuilds_before) / state.iterations();
+  state.counters["rebuild_share"] = rebuild_seconds / (rebuild_seconds + phases.step_pass - phases_before.step_pass);
+}
+
 void step_tank(benchmark::State& state, const fishtank::Kernels& kernels) {
   fishtank::enable_flush_denormals_to_zero();
   const int threads = static_cast<int>(state.range(0));
@@ -53,17 +68,7 @@ void step_tank(benchmark::State& state, const fishtank::Kernels& kernels) {
   for (const fishtank::BallView& b : settled_tank())
     world.place_ball(b.kind, {b.pos.x, b.pos.y, b.pos.z}, {b.vel.x, b.vel.y, b.vel.z});
   for (int s = 0; s < 50; ++s) world.step();  // first lists, warm caches
-  const std::uint64_t rebuilds_before = world.rebuilds();
-  const fishtank::PhaseSeconds phases_before = world.phase_seconds();
-  for (auto _ : state) world.step();
-  state.counters["ball_steps_per_s"] =
-      benchmark::Counter(double(state.iterations()) * world.ball_count(), benchmark::Counter::kIsRate);
-  // How much of the time went to neighbour-list rebuilds, which the settled
-  // state's rattling balls trigger (a rebuild costs several steps).
-  const fishtank::PhaseSeconds& phases = world.phase_seconds();
-  const double rebuild_seconds = phases.neighbours - phases_before.neighbours;
-  state.counters["rebuilds_per_kstep"] = 1000.0 * double(world.rebuilds() - rebuilds_before) / state.iterations();
-  state.counters["rebuild_share"] = rebuild_seconds / (rebuild_seconds + phases.step_pass - phases_before.step_pass);
+  time_steps(state, world);
 }
 
 void build_lists(benchmark::State& state, const fishtank::Kernels& kernels) {
@@ -105,17 +110,7 @@ World& wide_world(std::uint32_t balls) {
 void step_wide(benchmark::State& state) {
   fishtank::enable_flush_denormals_to_zero();
   World& world = wide_world(static_cast<std::uint32_t>(state.range(0)));
-  const std::uint64_t rebuilds_before = world.rebuilds();
-  const fishtank::PhaseSeconds phases_before = world.phase_seconds();
-  for (auto _ : state) world.step();
-  state.counters["ball_steps_per_s"] =
-      benchmark::Counter(double(state.iterations()) * world.ball_count(), benchmark::Counter::kIsRate);
-  // How much of the time went to neighbour-list rebuilds, which the settled
-  // state's rattling balls trigger (a rebuild costs several steps).
-  const fishtank::PhaseSeconds& phases = world.phase_seconds();
-  const double rebuild_seconds = phases.neighbours - phases_before.neighbours;
-  state.counters["rebuilds_per_kstep"] = 1000.0 * double(world.rebuilds() - rebuilds_before) / state.iterations();
-  state.counters["rebuild_share"] = rebuild_seconds / (rebuild_seconds + phases.step_pass - phases_before.step_pass);
+  time_steps(state, world);
 }
 
 }  // namespace
