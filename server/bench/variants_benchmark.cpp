@@ -76,7 +76,7 @@ void build_lists(benchmark::State& state, const fishtank::Kernels& kernels) {
   fishtank::AlignedVector<fishtank::Float4> unsorted;
   for (const fishtank::BallView& b : settled_tank()) unsorted.push_back(b.pos);
   const auto n = static_cast<std::uint32_t>(unsorted.size());
-  unsorted.resize(n + fishtank::kGhostSlots, fishtank::Float4{1e6f, 1e6f, 1e6f, 0.0f});
+  unsorted.resize(n + fishtank::kGhostSlots, fishtank::kGhostPos);
   fishtank::NeighbourList list;
   list.configure(params.tank, params.skin);
   std::vector<std::uint32_t> order;

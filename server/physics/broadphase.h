@@ -67,8 +67,10 @@ inline std::uint32_t finish_list(const ListBuild& b, std::uint32_t i, std::uint3
 }
 
 // Ghost slots after the last ball: a SIMD build reads up to three balls past
-// the end of a cell range, so arrays hold n + kGhostSlots entries.
+// the end of a cell range, so arrays hold n + kGhostSlots entries, each a
+// ghost parked where it touches nothing.
 constexpr std::uint32_t kGhostSlots = 4;
+constexpr Float4 kGhostPos{1e6f, 1e6f, 1e6f, 0.0f};
 
 // The number of cell (x, y, z) in the sort order.
 inline std::size_t cell_number(int x, int y, int z, int ny, int nz, int block) {

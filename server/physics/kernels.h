@@ -57,6 +57,26 @@ struct Kernels {
   std::uint32_t (*build_lists)(const ListBuild& b, std::uint32_t begin, std::uint32_t end);
 };
 
+// Every step kernel works through its chunk in batches of this many balls:
+// the neighbour sums of the whole batch first, then walls, players, kick and
+// drift for each ball (see kernels_simd_ball.h for why).
+constexpr std::uint32_t kStepBatch = 64;
+
+// The second half of a step for one ball, in plain C++: the half kick from
+// the full-step velocity v with acceleration a, then the drift from p into
+// vel_half_next and pos_next. Returns the squared distance of pos_next from
+// at_build. The scalar step kernel uses it, and so does the world for balls
+// whose acceleration it computes itself (spawned, or placed in contact).
+inline float kick_drift(const ContactModel& m, const Float4& v, const Float4& p, const Float4& a,
+                        const Float4& at_build, Float4& vel_half_next, Float4& pos_next) {
+  const Float4 vh{v.x + a.x * m.half_dt, v.y + a.y * m.half_dt, v.z + a.z * m.half_dt, v.w};
+  const Float4 next{p.x + vh.x * m.dt, p.y + vh.y * m.dt, p.z + vh.z * m.dt, p.w};
+  vel_half_next = vh;
+  pos_next = next;
+  const float dx = next.x - at_build.x, dy = next.y - at_build.y, dz = next.z - at_build.z;
+  return dx * dx + dy * dy + dz * dz;
+}
+
 extern const Kernels kScalarKernels;
 extern const Kernels kSseKernels;
 extern const Kernels kAvx2Kernels;  // run only where cpu_has_avx2()

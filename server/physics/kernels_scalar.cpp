@@ -88,25 +88,17 @@ float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
   const StepArrays s = arrays;
   const ContactModel m = model;
   float max_d2 = 0.0f;
-  // Batches of balls, as in the SIMD kernels (kernels_simd_ball.h): first the
-  // neighbour sums of the batch, then the rest for each ball.
-  constexpr std::uint32_t kBatch = 64;
-  Float4 pair_force[kBatch];
-  for (std::uint32_t batch = begin; batch < end; batch += kBatch) {
-    const std::uint32_t batch_end = std::min(end, batch + kBatch);
+  // Batches, as in the SIMD kernels: the neighbour sums of a batch, then the rest per ball.
+  Float4 pair_force[kStepBatch];
+  for (std::uint32_t batch = begin; batch < end; batch += kStepBatch) {
+    const std::uint32_t batch_end = std::min(end, batch + kStepBatch);
     for (std::uint32_t i = batch; i < batch_end; ++i) pair_force[i - batch] = pair_forces(s, m, i);
     for (std::uint32_t i = batch; i < batch_end; ++i) {
       const Float4 a = acceleration(s, m, i, pair_force[i - batch]);
-      const Float4 p = s.pos[i], vh = s.vel_half[i];
+      const Float4 vh = s.vel_half[i];
       const Float4 v{vh.x + a.x * m.half_dt, vh.y + a.y * m.half_dt, vh.z + a.z * m.half_dt, vh.w};
-      const Float4 vh_next{v.x + a.x * m.half_dt, v.y + a.y * m.half_dt, v.z + a.z * m.half_dt, v.w};
-      const Float4 p_next{p.x + vh_next.x * m.dt, p.y + vh_next.y * m.dt, p.z + vh_next.z * m.dt, p.w};
       s.vel[i] = v;
-      s.vel_half_next[i] = vh_next;
-      s.pos_next[i] = p_next;
-      const Float4& b = s.pos_at_build[i];
-      float dx = p_next.x - b.x, dy = p_next.y - b.y, dz = p_next.z - b.z;
-      max_d2 = std::max(max_d2, dx * dx + dy * dy + dz * dz);
+      max_d2 = std::max(max_d2, kick_drift(m, v, s.pos[i], a, s.pos_at_build[i], s.vel_half_next[i], s.pos_next[i]));
     }
   }
   return max_d2;

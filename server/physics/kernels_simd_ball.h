@@ -101,12 +101,11 @@ template <class V>
   return force / simd::broadcast<3>(v) + BallLanes<V>::both(F4::set(0.0f, -m.gravity, 0.0f, 0.0f));
 }
 
-// Balls are stepped in batches: first the neighbour sums of the whole batch,
-// then the rest for each ball. Neither loop then keeps the other's values in
-// registers, and the neighbour loops of 64 balls run back to back: faster
-// than one loop doing both, although it executes a few more instructions
-// (technical report, section 6.1). The scalar twin is batched the same way.
-constexpr std::uint32_t kBatch = 64;
+// Balls are stepped in batches of kStepBatch (kernels.h): first the neighbour
+// sums of the whole batch, then the rest for each ball. Neither loop then
+// keeps the other's values in registers, and the neighbour loops of a batch
+// run back to back: faster than one loop doing both, although it executes a
+// few more instructions (technical report, section 4).
 
 template <class V, PairForcesFn<V> PairForces>
 float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t begin, std::uint32_t end) {
@@ -119,9 +118,9 @@ float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
   const V dt_xyz = Lanes::both(F4::set(m.dt, m.dt, m.dt, 0.0f));  // keeps the radius in w
   const Walls<V> walls(m.tank);
   V max_d2 = V::zero();
-  alignas(32) Float4 pair_force[kBatch];
-  for (std::uint32_t batch = begin; batch < end; batch += kBatch) {
-    const std::uint32_t batch_end = std::min(end, batch + kBatch);
+  alignas(32) Float4 pair_force[kStepBatch];
+  for (std::uint32_t batch = begin; batch < end; batch += kStepBatch) {
+    const std::uint32_t batch_end = std::min(end, batch + kStepBatch);
     for (std::uint32_t first = batch; first < batch_end; first += Lanes::kBalls) {
       const std::uint32_t last = std::min(first + Lanes::kBalls, batch_end) - 1;
       const V f = PairForces(s, m, first, last, Lanes::load(s.pos, first, last), Lanes::load(s.vel_half, first, last));

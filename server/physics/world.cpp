@@ -13,7 +13,6 @@ namespace fishtank {
 namespace {
 
 constexpr float kPackingLimit = 0.6f;
-constexpr Float4 kGhostPos{1e6f, 1e6f, 1e6f, 0.0f};
 constexpr Float4 kGhostVel{0.0f, 0.0f, 0.0f, 1.0f};
 
 class PhaseTimer {
@@ -218,17 +217,7 @@ StepArrays World::arrays() {
 }
 
 float World::kick_drift(std::uint32_t i, const Float4& a) {
-  // The same arithmetic as the second half of the step kernels.
-  const Float4& v = vel_[i];
-  const Float4& p = pos_[i];
-  const float h = model_.half_dt;
-  Float4& vh = vel_half_next_[i];
-  vh = Float4{v.x + a.x * h, v.y + a.y * h, v.z + a.z * h, v.w};
-  Float4& next = pos_next_[i];
-  next = Float4{p.x + vh.x * model_.dt, p.y + vh.y * model_.dt, p.z + vh.z * model_.dt, p.w};
-  const Float4& b = pos_at_build_[i];
-  const float dx = next.x - b.x, dy = next.y - b.y, dz = next.z - b.z;
-  return dx * dx + dy * dy + dz * dz;
+  return fishtank::kick_drift(model_, vel_[i], pos_[i], a, pos_at_build_[i], vel_half_next_[i], pos_next_[i]);
 }
 
 void World::start_from_current_state() {

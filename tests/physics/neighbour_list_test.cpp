@@ -22,7 +22,7 @@ struct Lists {
 AlignedVector<Float4> random_balls(const TankBounds& tank, std::uint32_t n) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> x(tank.min.x, tank.max.x), y(tank.min.y, tank.max.y), z(tank.min.z, tank.max.z);
-  AlignedVector<Float4> pos(n + kGhostSlots, Float4{1e6f, 1e6f, 1e6f, 0.0f});
+  AlignedVector<Float4> pos(n + kGhostSlots, kGhostPos);
   for (std::uint32_t i = 0; i < n; ++i) pos[i] = {x(rng), y(rng), z(rng), 0.5f * kBallKinds[i % kKindCount].diameter};
   return pos;
 }
