@@ -1,6 +1,7 @@
 // Google Benchmark of whole physics steps, so ratios come from one process:
 //   step_tank/<variant>/<threads>  every kernel set on one settled 6000-ball tank
-//   build_lists/<variant>          one neighbour-list build of that tank, one thread
+//   build_lists/<variant>          one neighbour-list build of that tank, one thread,
+//                                  and the SIMD blocks per ball its lists ask for
 //   step_wide/sse/<balls>          the wide scene at 10^4, 10^5 and 10^6 balls
 //                                  (SSE on every core), each stepped 50 steps
 //                                  per repetition so all sizes advance through
@@ -13,6 +14,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <functional>
 #include <map>
@@ -71,6 +73,27 @@ void step_tank(benchmark::State& state, const fishtank::Kernels& kernels) {
   time_steps(state, world);
 }
 
+// SIMD blocks per ball that the lists ask for, for the ways of filling lanes
+// the technical report compares (section 4 and 6.1): one ball's neighbours
+// four or eight at a time, two balls side by side four each (the AVX2
+// kernel, as long as the longer list), four balls in lockstep one each.
+void report_block_counts(benchmark::State& state, const std::uint32_t* counts, std::uint32_t n) {
+  const auto blocks = [](std::uint32_t count, std::uint32_t lanes) { return (count + lanes - 1) / lanes; };
+  double neighbours = 0, one_ball_4 = 0, one_ball_8 = 0, two_balls = 0, four_balls = 0;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    neighbours += counts[i];
+    one_ball_4 += blocks(counts[i], 4);
+    one_ball_8 += blocks(counts[i], 8);
+    if (i % 2 == 0 && i + 1 < n) two_balls += blocks(std::max(counts[i], counts[i + 1]), 4);
+    if (i % 4 == 0 && i + 3 < n) four_balls += *std::max_element(counts + i, counts + i + 4);
+  }
+  state.counters["neighbours"] = neighbours / n;
+  state.counters["blocks4_one_ball"] = one_ball_4 / n;
+  state.counters["blocks8_one_ball"] = one_ball_8 / n;
+  state.counters["blocks8_two_balls"] = two_balls / n;
+  state.counters["blocks4_four_balls"] = four_balls / n;
+}
+
 void build_lists(benchmark::State& state, const fishtank::Kernels& kernels) {
   fishtank::PhysicsParams params;
   fishtank::AlignedVector<fishtank::Float4> unsorted;
@@ -86,6 +109,7 @@ void build_lists(benchmark::State& state, const fishtank::Kernels& kernels) {
   list.reserve(n, 32);
   const fishtank::ListBuild build = list.build_view(pos.data(), n);
   for (auto _ : state) benchmark::DoNotOptimize(kernels.build_lists(build, 0, n));
+  report_block_counts(state, list.counts(), n);
 }
 
 // One wide-scene world per size, dropped and run for the scene's 4 simulated
