@@ -34,13 +34,17 @@ inline F4 operator-(F4 a, F4 b) { return {_mm_sub_ps(a.v, b.v)}; }
 inline F4 operator*(F4 a, F4 b) { return {_mm_mul_ps(a.v, b.v)}; }
 inline F4 operator/(F4 a, F4 b) { return {_mm_div_ps(a.v, b.v)}; }
 inline F4& operator+=(F4& a, F4 b) { return a = a + b; }
+inline F4& operator-=(F4& a, F4 b) { return a = a - b; }
 inline F4 sqrt(F4 a) { return {_mm_sqrt_ps(a.v)}; }
-// 1/sqrt(a) to about 1e-7 relative: the 12-bit hardware estimate plus one
+// -1/sqrt(a) to about 1e-7 relative: the 12-bit hardware estimate plus one
 // Newton step. Cheaper than sqrt and divide, which share one slow unit.
-inline F4 rsqrt(F4 a) {
+// Negated because SSE's two-operand subtract can then take the constant from
+// memory (h - 1.5) instead of rebuilding it in a register for 1.5 - h on every
+// call; the negation is exact.
+inline F4 neg_rsqrt(F4 a) {
   __m128 r = _mm_rsqrt_ps(a.v);
   __m128 half_a_r2 = _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(0.5f), a.v), _mm_mul_ps(r, r));
-  return {_mm_mul_ps(r, _mm_sub_ps(_mm_set1_ps(1.5f), half_a_r2))};
+  return {_mm_mul_ps(r, _mm_sub_ps(half_a_r2, _mm_set1_ps(1.5f)))};
 }
 inline F4 max(F4 a, F4 b) { return {_mm_max_ps(a.v, b.v)}; }
 inline M4 operator<(F4 a, F4 b) { return {_mm_cmplt_ps(a.v, b.v)}; }

@@ -55,11 +55,23 @@ void NeighbourList::reserve(std::uint32_t n, std::uint32_t stride) {
   stride_ = padded_neighbour_count(std::max(stride, kListPadding), kListPadding);
   neighbours_.resize(std::size_t(n) * stride_);
   counts_.resize(n);
+  batch_order_.resize(n);
 }
 
 ListBuild NeighbourList::build_view(const Float4* pos, std::uint32_t n) {
-  return ListBuild{pos,    n,     cell_start_.data(), sorted_cell_.data(), nx_,    ny_, nz_,
-                   block_, skin_, neighbours_.data(), counts_.data(),      stride_};
+  return ListBuild{pos,
+                   n,
+                   cell_start_.data(),
+                   sorted_cell_.data(),
+                   nx_,
+                   ny_,
+                   nz_,
+                   block_,
+                   skin_,
+                   neighbours_.data(),
+                   counts_.data(),
+                   stride_,
+                   batch_order_.data()};
 }
 
 }  // namespace fishtank

@@ -47,6 +47,7 @@ struct ListBuild {
   std::uint32_t* neighbours;  // out: ball i's list at i * stride, ghost-padded
   std::uint32_t* counts;      // out: the true count, which may exceed stride
   std::uint32_t stride;
+  std::uint32_t* batch_order;  // out, SSE build only: per step batch, its balls by count (kernels_sse.cpp)
 };
 
 // Strides are a multiple of the four neighbours a SIMD kernel takes per ball
@@ -117,6 +118,7 @@ class NeighbourList {
   std::uint32_t stride() const { return stride_; }
   const std::uint32_t* neighbours() const { return neighbours_.data(); }
   const std::uint32_t* counts() const { return counts_.data(); }
+  const std::uint32_t* batch_order() const { return batch_order_.data(); }
 
  private:
   CellCoord cell_of(const Float4& p) const;
@@ -133,6 +135,7 @@ class NeighbourList {
   std::uint32_t stride_ = 0;
   std::vector<std::uint32_t> neighbours_;
   std::vector<std::uint32_t> counts_;
+  std::vector<std::uint32_t> batch_order_;
 };
 
 }  // namespace fishtank

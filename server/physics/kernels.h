@@ -2,7 +2,7 @@
 // The hot passes of a step (the step pass and the neighbour-list build), in
 // twins with the same signatures:
 //   kernels_scalar.cpp  plain C++, one pair at a time (the reference)
-//   kernels_sse.cpp     SSE4.1, four neighbours at a time
+//   kernels_sse.cpp     SSE4.1, four balls and one neighbour of each at a time
 //   kernels_avx2.cpp    AVX2 + FMA, two balls and four neighbours of each at a time (a third level)
 // The two SIMD files share their per-ball code (kernels_simd_ball.h).
 // A build picks one set at compile time (see server/main.cpp); the tests hold
@@ -16,6 +16,7 @@
 //   vel  = vel_half + a dt/2                 (the full step, what observers see)
 //   vel_half_next = vel + a dt/2,  pos_next = pos + vel_half_next dt
 
+#include <algorithm>
 #include <cstdint>
 
 #include "common/float4.h"
@@ -37,8 +38,9 @@ struct StepArrays {
   const std::uint32_t* neighbours;
   const std::uint32_t* neighbour_count;
   std::uint32_t stride;
-  const Float4* player_pos;  // x, y, z, radius
-  const Float4* player_vel;  // vx, vy, vz, 0
+  const std::uint32_t* batch_order;  // ListBuild::batch_order
+  const Float4* player_pos;          // x, y, z, radius
+  const Float4* player_vel;          // vx, vy, vz, 0
   int players;
 };
 
@@ -54,13 +56,22 @@ struct Kernels {
   void (*accelerations)(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin,
                         std::uint32_t end);
   // Neighbour lists of balls [begin, end) (see broadphase.h). Returns the longest.
+  // begin is a multiple of kStepBatch, and end is one too or the last ball's
+  // index + 1, as in every WorkerPool chunk of the world (the SSE build writes
+  // data per batch for the step passes that follow).
   std::uint32_t (*build_lists)(const ListBuild& b, std::uint32_t begin, std::uint32_t end);
 };
 
-// Every step kernel works through its chunk in batches of this many balls:
-// the neighbour sums of the whole batch first, then walls, players, kick and
-// drift for each ball (see kernels_simd_ball.h for why).
+// Every step kernel works through its chunk in batches of this many balls,
+// which start at multiples of kStepBatch: the neighbour sums of the whole
+// batch first, then walls, players, kick and drift for each ball (see
+// kernels_simd_ball.h for why).
 constexpr std::uint32_t kStepBatch = 64;
+
+// The end of the batch that holds ball `first`, within [.., end).
+inline std::uint32_t batch_end(std::uint32_t first, std::uint32_t end) {
+  return std::min(end, (first / kStepBatch + 1) * kStepBatch);
+}
 
 // The second half of a step for one ball, in plain C++: the half kick from
 // the full-step velocity v with acceleration a, then the drift from p into

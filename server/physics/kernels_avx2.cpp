@@ -2,14 +2,12 @@
 // each 128-bit half. See kernels.h for the passes and kernels_scalar.cpp for
 // the same arithmetic one pair at a time.
 //
-// Each half does what the SSE kernel of kernels_sse.cpp does for one ball:
-// four of its neighbours per block, loaded, transposed and computed at once.
-// A block therefore covers four neighbours of ball a and four of ball b, and
-// the per-ball work around the neighbour loop (loads, walls, kick, drift,
-// stores, the sum over lanes) is done for two balls per instruction, which is
-// where the SSE kernel spends about a third of its instructions. A ball has
-// 7.5 neighbours on average, so the pairs' blocks are about as well filled as
-// blocks of eight neighbours of one ball. The arithmetic is the SSE kernel's,
+// Each half takes four of its ball's neighbours per block, loaded, transposed
+// and computed at once. A block therefore covers four neighbours of ball a
+// and four of ball b, and the per-ball work around the neighbour loop (loads,
+// walls, kick, drift, stores, the sum over lanes) is done for two balls per
+// instruction. A ball has 7.5 neighbours on average, so the pairs' blocks are
+// about as well filled as blocks of eight neighbours of one ball. The arithmetic is the SSE kernel's,
 // with multiply-adds fused, so states agree with the other variants to float
 // rounding, not bit for bit.
 
@@ -37,10 +35,10 @@ struct BallLanes<F8> {
 
 // Sum over the neighbours of balls a (low half of p, v) and b (high half) of
 // the spring-dashpot force, as (Fx, Fy, Fz, 0) in each half.
-[[gnu::always_inline]] inline F8 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t a,
-                                             std::uint32_t b, F8 p, F8 v) {
-  // As in the SSE kernel, rows are subtracted before the transpose:
-  // p - pos[j] is (dx, dy, dz, ri - rj), v - vel[j] is (dvx, dvy, dvz, mi - mj).
+[[gnu::always_inline]] inline F8 pair_forces_of_two(const StepArrays& s, const ContactModel& m, std::uint32_t a,
+                                                    std::uint32_t b, F8 p, F8 v) {
+  // Rows are subtracted before the transpose, so only p, v and two broadcasts
+  // stay live: p - pos[j] is (dx, dy, dz, ri - rj), v - vel[j] is (dvx, dvy, dvz, mi - mj).
   const F8 two_ri = simd::broadcast<3>(p) + simd::broadcast<3>(p);
   const F8 mi = simd::broadcast<3>(v);
   const F8 k = F8::splat(m.k), damping = F8::splat(m.damping_factor);
@@ -83,6 +81,16 @@ struct BallLanes<F8> {
     fz = mul_add(f_over_dist, dz, fz);
   }
   return simd::sum_lanes_xyz(fx, fy, fz);
+}
+
+// The batch two balls at a time; an odd batch's last ball is carried in both
+// halves and stored twice, with the same result.
+void pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t first, std::uint32_t end, Float4* forces) {
+  for (std::uint32_t a = first; a < end; a += 2) {
+    const std::uint32_t b = std::min(a + 1, end - 1);
+    const F8 p = F8::load_pair(s.pos[a], s.pos[b]), v = F8::load_pair(s.vel_half[a], s.vel_half[b]);
+    pair_forces_of_two(s, m, a, b, p, v).store_pair(forces[a - first], forces[b - first]);
+  }
 }
 
 }  // namespace

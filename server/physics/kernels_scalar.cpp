@@ -90,10 +90,10 @@ float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
   float max_d2 = 0.0f;
   // Batches, as in the SIMD kernels: the neighbour sums of a batch, then the rest per ball.
   Float4 pair_force[kStepBatch];
-  for (std::uint32_t batch = begin; batch < end; batch += kStepBatch) {
-    const std::uint32_t batch_end = std::min(end, batch + kStepBatch);
-    for (std::uint32_t i = batch; i < batch_end; ++i) pair_force[i - batch] = pair_forces(s, m, i);
-    for (std::uint32_t i = batch; i < batch_end; ++i) {
+  for (std::uint32_t batch = begin, last_of_batch; batch < end; batch = last_of_batch) {
+    last_of_batch = batch_end(batch, end);
+    for (std::uint32_t i = batch; i < last_of_batch; ++i) pair_force[i - batch] = pair_forces(s, m, i);
+    for (std::uint32_t i = batch; i < last_of_batch; ++i) {
       const Float4 a = acceleration(s, m, i, pair_force[i - batch]);
       const Float4 vh = s.vel_half[i];
       const Float4 v{vh.x + a.x * m.half_dt, vh.y + a.y * m.half_dt, vh.z + a.z * m.half_dt, vh.w};

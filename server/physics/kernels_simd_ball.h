@@ -1,12 +1,11 @@
 #pragma once
 // The parts of the SIMD kernels that work per ball: walls, player spheres,
-// the step pass around a neighbour loop that each kernel file supplies, and
+// the step pass around the neighbour sums that each kernel file supplies, and
 // the neighbour-list build.
 //
-// A vector V carries one ball in four lanes (F4, kernels_sse.cpp) or two
-// balls, one per 128-bit half (F8, kernels_avx2.cpp); BallLanes<V> says how
-// to load and store them. The per-ball arithmetic (walls, kick, drift) then
-// serves two balls per instruction in the AVX2 kernels.
+// For the per-ball arithmetic (walls, kick, drift) a vector V carries one
+// ball in four lanes (F4, kernels_sse.cpp) or two balls, one per 128-bit half
+// (F8, kernels_avx2.cpp); BallLanes<V> says how to load and store them.
 //
 // Both files include this header and are compiled with different -m flags, so
 // everything here has internal linkage: each gets its own copy in its own
@@ -84,11 +83,10 @@ inline V wall_forces(const ContactModel& m, const Walls<V>& walls, V pi, V vi) {
   return keep(in_floor_or_wall, k * below - c * v) - keep(in_ceiling_or_wall, k * above + c * v);
 }
 
-// PairForces(s, m, first, last, p, v) sums the spring-dashpot forces of the
-// neighbours of the balls in p (positions) and v (half-step velocities), as
-// (Fx, Fy, Fz, 0) per ball.
-template <class V>
-using PairForcesFn = V (*)(const StepArrays&, const ContactModel&, std::uint32_t, std::uint32_t, V, V);
+// PairForces(s, m, first, end, forces) sums the spring-dashpot forces of the
+// neighbours of each ball b in [first, end), a batch of at most kStepBatch, into
+// forces[b - first] as (Fx, Fy, Fz, 0). Each kernel file supplies its own.
+using PairForcesFn = void (*)(const StepArrays&, const ContactModel&, std::uint32_t, std::uint32_t, Float4*);
 
 // a = F / m + g for the balls in p (positions) and v (half-step velocities),
 // given the sums of their neighbours' forces: adds walls and player spheres.
@@ -106,8 +104,23 @@ template <class V>
 // keeps the other's values in registers, and the neighbour loops of a batch
 // run back to back: faster than one loop doing both, although it executes a
 // few more instructions (technical report, section 4).
+// per_balls(first, last, pair_force) gets the balls of V one after another.
+template <class V, PairForcesFn PairForces, class PerBalls>
+[[gnu::always_inline]] inline void for_each_batch(const StepArrays& s, const ContactModel& m, std::uint32_t begin,
+                                                  std::uint32_t end, PerBalls per_balls) {
+  using Lanes = BallLanes<V>;
+  alignas(32) Float4 pair_force[kStepBatch];
+  for (std::uint32_t batch = begin, last_of_batch; batch < end; batch = last_of_batch) {
+    last_of_batch = batch_end(batch, end);
+    PairForces(s, m, batch, last_of_batch, pair_force);
+    for (std::uint32_t first = batch; first < last_of_batch; first += Lanes::kBalls) {
+      const std::uint32_t last = std::min(first + Lanes::kBalls, last_of_batch) - 1;
+      per_balls(first, last, Lanes::load(pair_force, first - batch, last - batch));
+    }
+  }
+}
 
-template <class V, PairForcesFn<V> PairForces>
+template <class V, PairForcesFn PairForces>
 float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t begin, std::uint32_t end) {
   using Lanes = BallLanes<V>;
   // Local copies: stores through the output pointers cannot change them, so
@@ -118,41 +131,30 @@ float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
   const V dt_xyz = Lanes::both(F4::set(m.dt, m.dt, m.dt, 0.0f));  // keeps the radius in w
   const Walls<V> walls(m.tank);
   V max_d2 = V::zero();
-  alignas(32) Float4 pair_force[kStepBatch];
-  for (std::uint32_t batch = begin; batch < end; batch += kStepBatch) {
-    const std::uint32_t batch_end = std::min(end, batch + kStepBatch);
-    for (std::uint32_t first = batch; first < batch_end; first += Lanes::kBalls) {
-      const std::uint32_t last = std::min(first + Lanes::kBalls, batch_end) - 1;
-      const V f = PairForces(s, m, first, last, Lanes::load(s.pos, first, last), Lanes::load(s.vel_half, first, last));
-      Lanes::store(f, pair_force, first - batch, last - batch);
-    }
-    for (std::uint32_t first = batch; first < batch_end; first += Lanes::kBalls) {
-      const std::uint32_t last = std::min(first + Lanes::kBalls, batch_end) - 1;
-      const V p = Lanes::load(s.pos, first, last);
-      const V vh = Lanes::load(s.vel_half, first, last);
-      const V a = acceleration(s, m, walls, p, vh, Lanes::load(pair_force, first - batch, last - batch));
-      const V v = vh + a * half_dt;
-      const V vh_next = v + a * half_dt;
-      const V p_next = p + vh_next * dt_xyz;
-      Lanes::store(v, s.vel, first, last);
-      Lanes::store(vh_next, s.vel_half_next, first, last);
-      Lanes::store(p_next, s.pos_next, first, last);
-      const V d = p_next - Lanes::load(s.pos_at_build, first, last);  // w lanes are both the radius
-      max_d2 = max(max_d2, dot3(d, d));
-    }
-  }
+  for_each_batch<V, PairForces>(s, m, begin, end, [&](std::uint32_t first, std::uint32_t last, V pair_force) {
+    const V p = Lanes::load(s.pos, first, last);
+    const V vh = Lanes::load(s.vel_half, first, last);
+    const V a = acceleration(s, m, walls, p, vh, pair_force);
+    const V v = vh + a * half_dt;
+    const V vh_next = v + a * half_dt;
+    const V p_next = p + vh_next * dt_xyz;
+    Lanes::store(v, s.vel, first, last);
+    Lanes::store(vh_next, s.vel_half_next, first, last);
+    Lanes::store(p_next, s.pos_next, first, last);
+    const V d = p_next - Lanes::load(s.pos_at_build, first, last);  // w lanes are both the radius
+    max_d2 = max(max_d2, dot3(d, d));
+  });
   return Lanes::lane0_max(max_d2);
 }
 
-template <class V, PairForcesFn<V> PairForces>
+template <class V, PairForcesFn PairForces>
 void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin, std::uint32_t end) {
   using Lanes = BallLanes<V>;
   const Walls<V> walls(m.tank);
-  for (std::uint32_t first = begin; first < end; first += Lanes::kBalls) {
-    const std::uint32_t last = std::min(first + Lanes::kBalls, end) - 1;
+  for_each_batch<V, PairForces>(s, m, begin, end, [&](std::uint32_t first, std::uint32_t last, V pair_force) {
     const V p = Lanes::load(s.pos, first, last), v = Lanes::load(s.vel_half, first, last);
-    Lanes::store(acceleration(s, m, walls, p, v, PairForces(s, m, first, last, p, v)), acc, first, last);
-  }
+    Lanes::store(acceleration(s, m, walls, p, v, pair_force), acc, first, last);
+  });
 }
 
 // Lists four candidates at a time: a cell range is contiguous in the sorted

@@ -1,10 +1,15 @@
 // SSE4.1 twin of the step kernels. See kernels.h for the passes and
 // kernels_scalar.cpp for the same arithmetic one pair at a time.
 //
-// Neighbours are taken four at a time: four aligned loads of (x, y, z, r),
-// a 4x4 transpose, and the contact arithmetic runs on four pairs per
-// instruction. Velocities are loaded and transposed only when at least one of
-// the four touches, which in a settled pile skips about half of the blocks.
+// Neighbour sums take four balls at a time, one per lane, and each lane walks
+// its own ball's list: a block is one neighbour of each of the four, loaded,
+// transposed, and computed at once. Per lane, a ball's forces are added in
+// list order, as in the scalar twin, and no sum over lanes is needed at the
+// end. A group of four costs as many blocks as its longest list, so the balls
+// of a batch are taken in order of their neighbour counts: on the settled tank
+// that is 1.95 blocks per ball, against 2.20 for one ball's neighbours four at
+// a time (technical report, section 4). Velocities are loaded for every
+// block: in a pile, 99 % of blocks have at least one lane in contact.
 // 1/|d| and sqrt(m_eff) come from the reciprocal-square-root estimate plus a
 // Newton step (1e-7 relative) instead of sqrt and divide; the scalar twin
 // computes them exactly, so the twins agree to float rounding, not bit for bit.
@@ -14,52 +19,97 @@
 namespace fishtank {
 namespace {
 
-// Sum over ball i's neighbours of the spring-dashpot force, as (Fx, Fy, Fz, 0).
-[[gnu::always_inline]] inline F4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t i,
-                                             std::uint32_t /*last: i, one ball per vector*/, F4 pi, F4 vi) {
-  // Differences are taken on whole rows before the transpose: pi - pos[j] is
-  // (dx, dy, dz, ri - rj) and vi - vel[j] is (dvx, dvy, dvz, mi - mj). That
-  // keeps only pi, vi and two broadcasts live instead of eight, so SSE's 16
-  // registers hold the loop without spilling to the stack.
-  const F4 two_ri = simd::broadcast<3>(pi) + simd::broadcast<3>(pi);
-  const F4 mi = simd::broadcast<3>(vi);
-  const F4 k = F4::splat(m.k), damping = F4::splat(m.damping_factor);
+// Balls first..end-1 of a batch, by neighbour count (a counting sort), padded
+// to a multiple of four with the last one repeated: a repeated ball is
+// computed twice and stored twice, with the same result. Returns the length.
+std::uint32_t by_neighbour_count(const std::uint32_t* counts, std::uint32_t first, std::uint32_t end,
+                                 std::uint32_t* order) {
+  constexpr std::uint32_t kBuckets = 32;  // longer lists share the last bucket: only the grouping is coarser
+  std::uint32_t start[kBuckets + 1] = {};
+  for (std::uint32_t b = first; b < end; ++b) ++start[std::min(counts[b], kBuckets - 1) + 1];
+  for (std::uint32_t c = 1; c <= kBuckets; ++c) start[c] += start[c - 1];
+  for (std::uint32_t b = first; b < end; ++b) order[start[std::min(counts[b], kBuckets - 1)]++] = b;
+  std::uint32_t n = end - first;
+  for (; n % 4 != 0; ++n) order[n] = order[n - 1];
+  return n;
+}
+
+// The shared SIMD build, then the order of every whole batch of the range,
+// so that the step passes until the next build need not sort (sorting every
+// step cost 8 % of the SSE step). A batch cut by the range's end, the last of
+// the balls, is sorted by the step itself.
+std::uint32_t build_lists_and_batch_order(const ListBuild& b, std::uint32_t begin, std::uint32_t end) {
+  const std::uint32_t longest = build_lists(b, begin, end);
+  for (std::uint32_t batch = begin; batch + kStepBatch <= end; batch += kStepBatch)
+    by_neighbour_count(b.counts, batch, batch + kStepBatch, b.batch_order + batch);
+  return longest;
+}
+
+// Sum over each ball's neighbours of the spring-dashpot force, as (Fx, Fy, Fz, 0).
+void pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t first, std::uint32_t end, Float4* forces) {
+  const F4 k = F4::splat(m.k), neg_damping = F4::splat(-m.damping_factor);
   const F4 tiny = F4::splat(1e-12f);  // squared distance floor: coincident centres stay finite
+  std::uint32_t sorted_here[kStepBatch + 3];
+  const bool whole = end - first == kStepBatch;
+  const std::uint32_t* order = whole ? s.batch_order + first : sorted_here;
+  const std::uint32_t grouped = whole ? kStepBatch : by_neighbour_count(s.neighbour_count, first, end, sorted_here);
+  for (const std::uint32_t* group = order; group < order + grouped; group += 4) {
+    const std::uint32_t a = group[0], b = group[1], c = group[2], d = group[3];
+    F4 xi, yi, zi, ri, vxi, vyi, vzi, mi;
+    simd::transpose(F4::load(s.pos[a]), F4::load(s.pos[b]), F4::load(s.pos[c]), F4::load(s.pos[d]), xi, yi, zi, ri);
+    simd::transpose(F4::load(s.vel_half[a]), F4::load(s.vel_half[b]), F4::load(s.vel_half[c]), F4::load(s.vel_half[d]),
+                    vxi, vyi, vzi, mi);
+    // Past its end, a shorter list's row holds the ghost: it touches nothing.
+    const std::uint32_t* row_a = s.neighbours + std::size_t(a) * s.stride;
+    const std::uint32_t* row_b = s.neighbours + std::size_t(b) * s.stride;
+    const std::uint32_t* row_c = s.neighbours + std::size_t(c) * s.stride;
+    const std::uint32_t* row_d = s.neighbours + std::size_t(d) * s.stride;
+    const std::uint32_t longest = std::max(std::max(s.neighbour_count[a], s.neighbour_count[b]),
+                                           std::max(s.neighbour_count[c], s.neighbour_count[d]));
 
-  F4 fx = F4::zero(), fy = F4::zero(), fz = F4::zero();
-  const std::uint32_t* list = s.neighbours + std::size_t(i) * s.stride;
-  const std::uint32_t count = padded_neighbour_count(s.neighbour_count[i], 4);
-  for (std::uint32_t n = 0; n < count; n += 4) {
-    const std::uint32_t j0 = list[n], j1 = list[n + 1], j2 = list[n + 2], j3 = list[n + 3];
-    F4 dx, dy, dz, ri_minus_rj;
-    simd::transpose(pi - F4::load(s.pos[j0]), pi - F4::load(s.pos[j1]), pi - F4::load(s.pos[j2]),
-                    pi - F4::load(s.pos[j3]), dx, dy, dz, ri_minus_rj);
-    F4 d2 = dx * dx + dy * dy + dz * dz;
-    F4 reach = two_ri - ri_minus_rj;  // ri + rj
-    M4 touching = d2 < reach * reach;
-    if (!simd::any(touching)) continue;
+    F4 fx = F4::zero(), fy = F4::zero(), fz = F4::zero();
+    for (std::uint32_t n = 0; n < longest; ++n) {
+      const std::uint32_t ja = row_a[n], jb = row_b[n], jc = row_c[n], jd = row_d[n];
+      // d and dv point from ball i to its neighbour, the opposite of the scalar
+      // twin's: SSE's two-operand subtract then needs no copy of ball i's lanes.
+      // Negations are exact, and below they cancel in pairs, so every value is
+      // the scalar formula's (up to the estimates).
+      F4 dx, dy, dz, rj;
+      simd::transpose(F4::load(s.pos[ja]), F4::load(s.pos[jb]), F4::load(s.pos[jc]), F4::load(s.pos[jd]), dx, dy, dz,
+                      rj);
+      dx -= xi, dy -= yi, dz -= zi;
+      const F4 d2 = dx * dx + dy * dy + dz * dz;
+      const F4 reach = rj + ri;
+      const M4 touching = d2 < reach * reach;
 
-    F4 dvx, dvy, dvz, mi_minus_mj;
-    simd::transpose(vi - F4::load(s.vel_half[j0]), vi - F4::load(s.vel_half[j1]), vi - F4::load(s.vel_half[j2]),
-                    vi - F4::load(s.vel_half[j3]), dvx, dvy, dvz, mi_minus_mj);
-    F4 inv_dist = simd::rsqrt(max(d2, tiny));
-    F4 dist = d2 * inv_dist;
-    F4 v_n_dist = dvx * dx + dvy * dy + dvz * dz;  // v_n |d|
-    // sqrt(m_eff) = sqrt(mi mj / (mi + mj)) = mi mj / sqrt(mi mj (mi + mj)): one estimate, no reciprocal.
-    F4 mj = mi - mi_minus_mj;
-    F4 mi_mj = mi * mj;
-    F4 c = damping * mi_mj * simd::rsqrt(mi_mj * (mi + mj));  // damping * sqrt(m_eff)
-    // f / |d| multiplies the unnormalised d: the normal is never formed.
-    F4 f_over_dist = keep(touching, (k * (reach - dist) - c * (v_n_dist * inv_dist)) * inv_dist);
-    fx += f_over_dist * dx;
-    fy += f_over_dist * dy;
-    fz += f_over_dist * dz;
+      F4 dvx, dvy, dvz, mj;
+      simd::transpose(F4::load(s.vel_half[ja]), F4::load(s.vel_half[jb]), F4::load(s.vel_half[jc]),
+                      F4::load(s.vel_half[jd]), dvx, dvy, dvz, mj);
+      dvx -= vxi, dvy -= vyi, dvz -= vzi;
+      const F4 neg_inv_dist = simd::neg_rsqrt(max(d2, tiny));
+      const F4 neg_dist = d2 * neg_inv_dist;
+      const F4 v_n_dist = dvx * dx + dvy * dy + dvz * dz;  // v_n |d|
+      // sqrt(m_eff) = sqrt(mi mj / (mi + mj)) = mi mj / sqrt(mi mj (mi + mj)): one estimate, no reciprocal.
+      const F4 mi_mj = mi * mj;
+      const F4 c = neg_damping * mi_mj * simd::neg_rsqrt(mi_mj * (mi + mj));  // damping * sqrt(m_eff)
+      // f / |d| multiplies the unnormalised d: the normal is never formed.
+      const F4 f_over_dist = keep(touching, (k * (reach + neg_dist) + c * (v_n_dist * neg_inv_dist)) * neg_inv_dist);
+      fx += f_over_dist * dx;
+      fy += f_over_dist * dy;
+      fz += f_over_dist * dz;
+    }
+    F4 fa, fb, fc, fd;
+    simd::transpose(fx, fy, fz, F4::zero(), fa, fb, fc, fd);
+    fa.store(forces[a - first]);
+    fb.store(forces[b - first]);
+    fc.store(forces[c - first]);
+    fd.store(forces[d - first]);
   }
-  return simd::sum_lanes_xyz(fx, fy, fz);
 }
 
 }  // namespace
 
-const Kernels kSseKernels{"sse", "sse4.1", true, step<F4, pair_forces>, accelerations<F4, pair_forces>, build_lists};
+const Kernels kSseKernels{
+    "sse", "sse4.1", true, step<F4, pair_forces>, accelerations<F4, pair_forces>, build_lists_and_batch_order};
 
 }  // namespace fishtank

@@ -25,7 +25,8 @@ constexpr std::uint32_t kMinItemsPerThread = 1024;
 
 int WorkerPool::hardware_threads() { return std::max(1u, boost::thread::hardware_concurrency()); }
 
-WorkerPool::WorkerPool(int threads) : thread_count_(std::max(1, threads)), active_limit_(thread_count_) {
+WorkerPool::WorkerPool(int threads, std::uint32_t granule)
+    : thread_count_(std::max(1, threads)), granule_(std::max(1u, granule)), active_limit_(thread_count_) {
   for (int t = 1; t < thread_count_; ++t) workers_.emplace_back([this, t] { worker_loop(t); });
 }
 
@@ -43,9 +44,14 @@ void WorkerPool::set_active_limit(int limit) { active_limit_ = std::clamp(limit,
 
 void WorkerPool::run_chunk(int thread) {
   if (thread >= active_) return;
-  std::uint64_t n = count_;
-  auto begin = static_cast<std::uint32_t>(n * thread / active_);
-  auto end = static_cast<std::uint32_t>(n * (thread + 1) / active_);
+  const std::uint64_t n = count_;
+  const auto chunk_start = [&](int t) {
+    // The nearest multiple of the granule: rounding down would hand the last thread up to a granule more.
+    return t == active_ ? count_
+                        : static_cast<std::uint32_t>(
+                              std::min<std::uint64_t>(n, (n * t / active_ + granule_ / 2) / granule_ * granule_));
+  };
+  const std::uint32_t begin = chunk_start(thread), end = chunk_start(thread + 1);
   if (begin < end) (*phase_)(begin, end, thread);
 }
 

@@ -6,7 +6,10 @@
 //        └──────── waits until `pending` reaches 0 ◄─────────┘
 //
 // Work is split statically into T contiguous chunks, so each thread streams
-// through its own part of the arrays and results never depend on timing. A
+// through its own part of the arrays and results never depend on timing.
+// Chunks start at multiples of a granule, so every pass over the same count
+// puts each granule-sized block of items on one thread, whatever the number
+// of threads (the SSE kernels keep per-block data from one pass to the next). A
 // phase lasts tens of microseconds in benchmark mode, so workers spin briefly
 // before sleeping on a condition variable: a wake-up from spinning costs well
 // under a microsecond, one from sleep several. With one thread, run() is a
@@ -29,7 +32,7 @@ class WorkerPool {
   // Chunk [begin, end) of `count` items, on thread `thread`.
   using Phase = std::function<void(std::uint32_t begin, std::uint32_t end, int thread)>;
 
-  explicit WorkerPool(int threads);
+  WorkerPool(int threads, std::uint32_t granule);
   ~WorkerPool();
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
@@ -52,6 +55,7 @@ class WorkerPool {
   void run_chunk(int thread);
 
   int thread_count_;
+  std::uint32_t granule_;
   std::vector<boost::thread> workers_;
   const Phase* phase_ = nullptr;
   std::uint32_t count_ = 0;

@@ -36,7 +36,7 @@ World::World(const PhysicsParams& params, const Kernels& kernels, int threads, s
     : params_(params),
       model_(make_contact_model(params)),
       kernels_(kernels),
-      pool_(kernels.threaded ? threads : 1),
+      pool_(kernels.threaded ? threads : 1, kStepBatch),
       spawner_(params.tank, seed) {
   enable_flush_denormals_to_zero();
   list_.configure(params.tank, params.skin);
@@ -210,10 +210,19 @@ void World::rebuild() {
 }
 
 StepArrays World::arrays() {
-  return StepArrays{pos_.data(),        vel_half_.data(),      vel_.data(),
-                    pos_next_.data(),   vel_half_next_.data(), pos_at_build_.data(),
-                    list_.neighbours(), list_.counts(),        list_.stride(),
-                    player_pos_.data(), player_vel_.data(),    static_cast<int>(player_pos_.size())};
+  return StepArrays{pos_.data(),
+                    vel_half_.data(),
+                    vel_.data(),
+                    pos_next_.data(),
+                    vel_half_next_.data(),
+                    pos_at_build_.data(),
+                    list_.neighbours(),
+                    list_.counts(),
+                    list_.stride(),
+                    list_.batch_order(),
+                    player_pos_.data(),
+                    player_vel_.data(),
+                    static_cast<int>(player_pos_.size())};
 }
 
 float World::kick_drift(std::uint32_t i, const Float4& a) {

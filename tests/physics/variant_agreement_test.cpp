@@ -1,5 +1,6 @@
 // The scalar and SSE twins compute the same physics: the same trajectories
-// over a short horizon (they differ only in the order of float additions),
+// over a short horizon (they differ only in float rounding: the SIMD kernels'
+// reciprocal-square-root estimates, and the AVX2 kernel's order of additions),
 // and the same settled pile over a long one, where chaos has long since
 // separated individual trajectories.
 
