@@ -85,7 +85,10 @@ struct BallLanes<F8> {
 
 // The batch two balls at a time; an odd batch's last ball is carried in both
 // halves and stored twice, with the same result.
-void pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t first, std::uint32_t end, Float4* forces) {
+void pair_forces(const StepArrays& arrays, const ContactModel& model, std::uint32_t first, std::uint32_t end,
+                 Float4* forces) {
+  const StepArrays s = arrays;  // local copies: the stores to forces cannot change them (see step)
+  const ContactModel m = model;
   for (std::uint32_t a = first; a < end; a += 2) {
     const std::uint32_t b = std::min(a + 1, end - 1);
     const F8 p = F8::load_pair(s.pos[a], s.pos[b]), v = F8::load_pair(s.vel_half[a], s.vel_half[b]);

@@ -46,7 +46,9 @@ std::uint32_t build_lists_and_batch_order(const ListBuild& b, std::uint32_t begi
 }
 
 // Sum over each ball's neighbours of the spring-dashpot force, as (Fx, Fy, Fz, 0).
-void pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t first, std::uint32_t end, Float4* forces) {
+void pair_forces(const StepArrays& arrays, const ContactModel& m, std::uint32_t first, std::uint32_t end,
+                 Float4* forces) {
+  const StepArrays s = arrays;  // a local copy: the stores to forces cannot change it (see step)
   const F4 k = F4::splat(m.k), neg_damping = F4::splat(-m.damping_factor);
   const F4 tiny = F4::splat(1e-12f);  // squared distance floor: coincident centres stay finite
   std::uint32_t sorted_here[kStepBatch + 3];
