@@ -89,12 +89,5 @@ inline void transpose(F8 a, F8 b, F8 c, F8 d, F8& xs, F8& ys, F8& zs, F8& ws) {
   ws.v = _mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(3, 2, 3, 2));
 }
 
-// Per half, the sum of its four lanes of each input, packed as (sum x, sum y, sum z, 0).
-inline F8 sum_lanes_xyz(F8 xs, F8 ys, F8 zs) {
-  __m256 t0 = _mm256_hadd_ps(xs.v, ys.v);                 // x01 x23 y01 y23, per half
-  __m256 t1 = _mm256_hadd_ps(zs.v, _mm256_setzero_ps());  // z01 z23 0 0
-  return {_mm256_hadd_ps(t0, t1)};                        // x y z 0
-}
-
 }  // namespace FISHTANK_SIMD_ISA_NAMESPACE
 }  // namespace fishtank::simd

@@ -78,13 +78,6 @@ inline void transpose(F4 a, F4 b, F4 c, F4 d, F4& xs, F4& ys, F4& zs, F4& ws) {
   ws.v = _mm_movehl_ps(t3, t2);
 }
 
-// Sum of the four lanes of each input, packed as (sum x, sum y, sum z, 0).
-inline F4 sum_lanes_xyz(F4 xs, F4 ys, F4 zs) {
-  __m128 t0 = _mm_hadd_ps(xs.v, ys.v);              // x01 x23 y01 y23
-  __m128 t1 = _mm_hadd_ps(zs.v, _mm_setzero_ps());  // z01 z23 0 0
-  return {_mm_hadd_ps(t0, t1)};                     // x y z 0
-}
-
 inline M4 operator&(M4 a, M4 b) { return {_mm_and_ps(a.v, b.v)}; }
 inline int bits(M4 m) { return _mm_movemask_ps(m.v); }  // lane L's flag in bit L
 

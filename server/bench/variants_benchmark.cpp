@@ -75,12 +75,14 @@ void step_tank(benchmark::State& state, const fishtank::Kernels& kernels) {
 
 // SIMD blocks per ball that the lists ask for, for the ways of filling lanes
 // the technical report compares (section 4 and 6.1): one ball's neighbours
-// four or eight at a time, two balls side by side four each (the AVX2
-// kernel, as long as the longer list), four balls in lockstep one each, as
-// they come or by neighbour count within each step batch (the SSE kernel).
+// four or eight at a time, two balls side by side four each (as long as the
+// longer list), four balls in lockstep one each as they come, and four or
+// eight in lockstep by neighbour count within each step batch (the SSE and
+// AVX2 kernels).
 void report_block_counts(benchmark::State& state, const std::uint32_t* counts, std::uint32_t n) {
   const auto blocks = [](std::uint32_t count, std::uint32_t lanes) { return (count + lanes - 1) / lanes; };
-  double neighbours = 0, one_ball_4 = 0, one_ball_8 = 0, two_balls = 0, four_balls = 0, four_by_count = 0;
+  double neighbours = 0, one_ball_4 = 0, one_ball_8 = 0, two_balls = 0, four_balls = 0, four_by_count = 0,
+         eight_by_count = 0;
   for (std::uint32_t i = 0; i < n; ++i) {
     neighbours += counts[i];
     one_ball_4 += blocks(counts[i], 4);
@@ -92,6 +94,7 @@ void report_block_counts(benchmark::State& state, const std::uint32_t* counts, s
     std::vector<std::uint32_t> sorted(counts + batch, counts + std::min(n, batch + fishtank::kStepBatch));
     std::sort(sorted.begin(), sorted.end());
     for (std::size_t g = 3; g < sorted.size() + 3; g += 4) four_by_count += sorted[std::min(g, sorted.size() - 1)];
+    for (std::size_t g = 7; g < sorted.size() + 7; g += 8) eight_by_count += sorted[std::min(g, sorted.size() - 1)];
   }
   state.counters["neighbours"] = neighbours / n;
   state.counters["blocks4_one_ball"] = one_ball_4 / n;
@@ -99,6 +102,7 @@ void report_block_counts(benchmark::State& state, const std::uint32_t* counts, s
   state.counters["blocks8_two_balls"] = two_balls / n;
   state.counters["blocks4_four_balls"] = four_balls / n;
   state.counters["blocks4_four_balls_by_count"] = four_by_count / n;
+  state.counters["blocks8_eight_balls_by_count"] = eight_by_count / n;
 }
 
 void build_lists(benchmark::State& state, const fishtank::Kernels& kernels) {

@@ -1,15 +1,14 @@
-// AVX2 + FMA level of the step kernels: two balls per 256-bit vector, one in
-// each 128-bit half. See kernels.h for the passes and kernels_scalar.cpp for
-// the same arithmetic one pair at a time.
+// AVX2 + FMA level of the step kernels. See kernels.h for the passes and
+// kernels_scalar.cpp for the same arithmetic one pair at a time.
 //
-// Each half takes four of its ball's neighbours per block, loaded, transposed
-// and computed at once. A block therefore covers four neighbours of ball a
-// and four of ball b, and the per-ball work around the neighbour loop (loads,
-// walls, kick, drift, stores, the sum over lanes) is done for two balls per
-// instruction. A ball has 7.5 neighbours on average, so the pairs' blocks are
-// about as well filled as blocks of eight neighbours of one ball. The arithmetic is the SSE kernel's,
-// with multiply-adds fused, so states agree with the other variants to float
-// rounding, not bit for bit.
+// Neighbour sums work as in the SSE kernel (kernels_sse.cpp), eight balls at
+// a time: one ball per lane, each lane walking its own ball's list, so a
+// block is one neighbour of each of eight balls, taken in order of their
+// neighbour counts. AVX's shuffles work within 128-bit halves, so lanes l and
+// l + 4 come from one paired load and the SSE 4x4 transpose serves both
+// halves. The per-ball code (walls, kick, drift) carries two balls per
+// vector, one per half. Multiply-adds are fused, so states agree with the
+// other variants to float rounding, not bit for bit.
 
 #include "common/simd/avx_float8.h"
 #include "server/physics/kernels_simd_ball.h"
@@ -33,72 +32,68 @@ struct BallLanes<F8> {
   static float lane0_max(F8 a) { return simd::lane(max(a.lo(), a.hi()), 0); }
 };
 
-// Sum over the neighbours of balls a (low half of p, v) and b (high half) of
-// the spring-dashpot force, as (Fx, Fy, Fz, 0) in each half.
-[[gnu::always_inline]] inline F8 pair_forces_of_two(const StepArrays& s, const ContactModel& m, std::uint32_t a,
-                                                    std::uint32_t b, F8 p, F8 v) {
-  // Rows are subtracted before the transpose, so only p, v and two broadcasts
-  // stay live: p - pos[j] is (dx, dy, dz, ri - rj), v - vel[j] is (dvx, dvy, dvz, mi - mj).
-  const F8 two_ri = simd::broadcast<3>(p) + simd::broadcast<3>(p);
-  const F8 mi = simd::broadcast<3>(v);
-  const F8 k = F8::splat(m.k), damping = F8::splat(m.damping_factor);
-  const F8 tiny = F8::splat(1e-12f);  // squared distance floor: coincident centres stay finite
-
-  // Past its end, the shorter list's row holds ghosts: they touch nothing.
-  const std::uint32_t* list_a = s.neighbours + std::size_t(a) * s.stride;
-  const std::uint32_t* list_b = s.neighbours + std::size_t(b) * s.stride;
-  const std::uint32_t count = padded_neighbour_count(std::max(s.neighbour_count[a], s.neighbour_count[b]), 4);
-
-  F8 fx = F8::zero(), fy = F8::zero(), fz = F8::zero();
-  for (std::uint32_t n = 0; n < count; n += 4) {
-    const std::uint32_t* ja = list_a + n;
-    const std::uint32_t* jb = list_b + n;
-    F8 dx, dy, dz, ri_minus_rj;
-    simd::transpose(p - F8::load_pair(s.pos[ja[0]], s.pos[jb[0]]), p - F8::load_pair(s.pos[ja[1]], s.pos[jb[1]]),
-                    p - F8::load_pair(s.pos[ja[2]], s.pos[jb[2]]), p - F8::load_pair(s.pos[ja[3]], s.pos[jb[3]]), dx,
-                    dy, dz, ri_minus_rj);
-    F8 d2 = mul_add(dz, dz, mul_add(dy, dy, dx * dx));
-    F8 reach = two_ri - ri_minus_rj;  // ri + rj
-    M8 touching = d2 < reach * reach;
-    if (!simd::any(touching)) continue;
-
-    F8 dvx, dvy, dvz, mi_minus_mj;
-    simd::transpose(v - F8::load_pair(s.vel_half[ja[0]], s.vel_half[jb[0]]),
-                    v - F8::load_pair(s.vel_half[ja[1]], s.vel_half[jb[1]]),
-                    v - F8::load_pair(s.vel_half[ja[2]], s.vel_half[jb[2]]),
-                    v - F8::load_pair(s.vel_half[ja[3]], s.vel_half[jb[3]]), dvx, dvy, dvz, mi_minus_mj);
-    F8 inv_dist = simd::rsqrt(max(d2, tiny));
-    F8 dist = d2 * inv_dist;
-    F8 v_n_dist = mul_add(dvz, dz, mul_add(dvy, dy, dvx * dx));  // v_n |d|
-    // sqrt(m_eff) = sqrt(mi mj / (mi + mj)) = mi mj / sqrt(mi mj (mi + mj)): one estimate, no reciprocal.
-    F8 mj = mi - mi_minus_mj;
-    F8 mi_mj = mi * mj;
-    F8 c = damping * mi_mj * simd::rsqrt(mi_mj * (mi + mj));  // damping * sqrt(m_eff)
-    // f / |d| multiplies the unnormalised d: the normal is never formed.
-    F8 f_over_dist = keep(touching, neg_mul_add(c, v_n_dist * inv_dist, k * (reach - dist)) * inv_dist);
-    fx = mul_add(f_over_dist, dx, fx);
-    fy = mul_add(f_over_dist, dy, fy);
-    fz = mul_add(f_over_dist, dz, fz);
-  }
-  return simd::sum_lanes_xyz(fx, fy, fz);
+// Rows a[j[0..7]] as four vectors of lanes: x, y, z, w, with ball j[l] in
+// lane l of the low half and j[l + 4] in lane l of the high half.
+[[gnu::always_inline]] inline void lanes_of(const Float4* a, const std::uint32_t* j, F8& x, F8& y, F8& z, F8& w) {
+  simd::transpose(F8::load_pair(a[j[0]], a[j[4]]), F8::load_pair(a[j[1]], a[j[5]]), F8::load_pair(a[j[2]], a[j[6]]),
+                  F8::load_pair(a[j[3]], a[j[7]]), x, y, z, w);
 }
 
-// The batch two balls at a time; an odd batch's last ball is carried in both
-// halves and stored twice, with the same result.
-void pair_forces(const StepArrays& arrays, const ContactModel& model, std::uint32_t first, std::uint32_t end,
+// Sum over each ball's neighbours of the spring-dashpot force, as (Fx, Fy, Fz, 0).
+void pair_forces(const StepArrays& arrays, const ContactModel& m, std::uint32_t first, std::uint32_t end,
                  Float4* forces) {
-  const StepArrays s = arrays;  // local copies: the stores to forces cannot change them (see step)
-  const ContactModel m = model;
-  for (std::uint32_t a = first; a < end; a += 2) {
-    const std::uint32_t b = std::min(a + 1, end - 1);
-    const F8 p = F8::load_pair(s.pos[a], s.pos[b]), v = F8::load_pair(s.vel_half[a], s.vel_half[b]);
-    pair_forces_of_two(s, m, a, b, p, v).store_pair(forces[a - first], forces[b - first]);
+  const StepArrays s = arrays;  // a local copy: the stores to forces cannot change it (see step)
+  const F8 k = F8::splat(m.k), damping = F8::splat(m.damping_factor);
+  const F8 tiny = F8::splat(1e-12f);  // squared distance floor: coincident centres stay finite
+  BatchOrder order(s, first, end, 8);
+  for (const std::uint32_t* group = order.begin(); group < order.end(); group += 8) {
+    F8 xi, yi, zi, ri, vxi, vyi, vzi, mi;
+    lanes_of(s.pos, group, xi, yi, zi, ri);
+    lanes_of(s.vel_half, group, vxi, vyi, vzi, mi);
+    // Past its end, a shorter list's row holds the ghost: it touches nothing.
+    const std::uint32_t* row[8];
+    std::uint32_t longest = 0;
+    for (int l = 0; l < 8; ++l) {
+      row[l] = s.neighbours + std::size_t(group[l]) * s.stride;
+      longest = std::max(longest, s.neighbour_count[group[l]]);
+    }
+
+    F8 fx = F8::zero(), fy = F8::zero(), fz = F8::zero();
+    for (std::uint32_t n = 0; n < longest; ++n) {
+      const std::uint32_t j[8] = {row[0][n], row[1][n], row[2][n], row[3][n],
+                                  row[4][n], row[5][n], row[6][n], row[7][n]};
+      F8 xj, yj, zj, rj, vxj, vyj, vzj, mj;
+      lanes_of(s.pos, j, xj, yj, zj, rj);
+      const F8 dx = xi - xj, dy = yi - yj, dz = zi - zj;
+      const F8 d2 = mul_add(dz, dz, mul_add(dy, dy, dx * dx));
+      const F8 reach = ri + rj;
+      const M8 touching = d2 < reach * reach;
+      lanes_of(s.vel_half, j, vxj, vyj, vzj, mj);
+      const F8 inv_dist = simd::rsqrt(max(d2, tiny));
+      const F8 dist = d2 * inv_dist;
+      const F8 v_n_dist = mul_add(vzi - vzj, dz, mul_add(vyi - vyj, dy, (vxi - vxj) * dx));  // v_n |d|
+      // sqrt(m_eff) = sqrt(mi mj / (mi + mj)) = mi mj / sqrt(mi mj (mi + mj)): one estimate, no reciprocal.
+      const F8 mi_mj = mi * mj;
+      const F8 c = damping * mi_mj * simd::rsqrt(mi_mj * (mi + mj));  // damping * sqrt(m_eff)
+      // f / |d| multiplies the unnormalised d: the normal is never formed.
+      const F8 f_over_dist = keep(touching, neg_mul_add(c, v_n_dist * inv_dist, k * (reach - dist)) * inv_dist);
+      fx = mul_add(f_over_dist, dx, fx);
+      fy = mul_add(f_over_dist, dy, fy);
+      fz = mul_add(f_over_dist, dz, fz);
+    }
+    // The same transpose turns lanes back into rows: (Fx, Fy, Fz, 0) of ball group[l] | group[l + 4].
+    F8 f0, f1, f2, f3;
+    simd::transpose(fx, fy, fz, F8::zero(), f0, f1, f2, f3);
+    f0.store_pair(forces[group[0] - first], forces[group[4] - first]);
+    f1.store_pair(forces[group[1] - first], forces[group[5] - first]);
+    f2.store_pair(forces[group[2] - first], forces[group[6] - first]);
+    f3.store_pair(forces[group[3] - first], forces[group[7] - first]);
   }
 }
 
 }  // namespace
 
-const Kernels kAvx2Kernels{"avx2",     "avx2+fma", true, step<F8, pair_forces>, accelerations<F8, pair_forces>,
-                           build_lists};
+const Kernels kAvx2Kernels{
+    "avx2", "avx2+fma", true, step<F8, pair_forces>, accelerations<F8, pair_forces>, build_lists_and_batch_order};
 
 }  // namespace fishtank

@@ -197,5 +197,54 @@ inline std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::u
   return longest;
 }
 
+// Balls first..end-1 of a batch, by neighbour count (a counting sort), padded
+// to a multiple of `lanes` with the last one repeated: a repeated ball is
+// computed twice and stored twice, with the same result. Returns the length.
+// Both SIMD kernels take one ball per lane and one neighbour of each per
+// block, so a group costs as many blocks as its longest list; grouping balls
+// of equal counts keeps the blocks full (kernels_sse.cpp).
+inline std::uint32_t by_neighbour_count(const std::uint32_t* counts, std::uint32_t first, std::uint32_t end,
+                                        std::uint32_t lanes, std::uint32_t* order) {
+  constexpr std::uint32_t kBuckets = 32;  // longer lists share the last bucket: only the grouping is coarser
+  std::uint32_t start[kBuckets + 1] = {};
+  for (std::uint32_t b = first; b < end; ++b) ++start[std::min(counts[b], kBuckets - 1) + 1];
+  for (std::uint32_t c = 1; c <= kBuckets; ++c) start[c] += start[c - 1];
+  for (std::uint32_t b = first; b < end; ++b) order[start[std::min(counts[b], kBuckets - 1)]++] = b;
+  std::uint32_t n = end - first;
+  for (; n % lanes != 0; ++n) order[n] = order[n - 1];
+  return n;
+}
+
+// The SIMD build, then the order of every whole batch of the range, so that
+// the step passes until the next build need not sort (sorting every step cost
+// 8 % of the SSE step). A batch cut by the range's end, the last of the balls,
+// is sorted by the step itself. kStepBatch is a multiple of every lane count.
+inline std::uint32_t build_lists_and_batch_order(const ListBuild& b, std::uint32_t begin, std::uint32_t end) {
+  const std::uint32_t longest = build_lists(b, begin, end);
+  for (std::uint32_t batch = begin; batch + kStepBatch <= end; batch += kStepBatch)
+    by_neighbour_count(b.counts, batch, batch + kStepBatch, 1, b.batch_order + batch);
+  return longest;
+}
+
+// The balls of batch [first, end) by neighbour count, in groups of `lanes`
+// (at most 8): the order the list build wrote for a whole batch, or one
+// sorted here for a batch cut short.
+class BatchOrder {
+ public:
+  BatchOrder(const StepArrays& s, std::uint32_t first, std::uint32_t end, std::uint32_t lanes)
+      : begin_(s.batch_order + first), length_(kStepBatch) {
+    if (end - first == kStepBatch) return;
+    length_ = by_neighbour_count(s.neighbour_count, first, end, lanes, sorted_here_);
+    begin_ = sorted_here_;
+  }
+  const std::uint32_t* begin() const { return begin_; }
+  const std::uint32_t* end() const { return begin_ + length_; }
+
+ private:
+  std::uint32_t sorted_here_[kStepBatch + 7];
+  const std::uint32_t* begin_;
+  std::uint32_t length_;
+};
+
 }  // namespace
 }  // namespace fishtank

@@ -19,43 +19,14 @@
 namespace fishtank {
 namespace {
 
-// Balls first..end-1 of a batch, by neighbour count (a counting sort), padded
-// to a multiple of four with the last one repeated: a repeated ball is
-// computed twice and stored twice, with the same result. Returns the length.
-std::uint32_t by_neighbour_count(const std::uint32_t* counts, std::uint32_t first, std::uint32_t end,
-                                 std::uint32_t* order) {
-  constexpr std::uint32_t kBuckets = 32;  // longer lists share the last bucket: only the grouping is coarser
-  std::uint32_t start[kBuckets + 1] = {};
-  for (std::uint32_t b = first; b < end; ++b) ++start[std::min(counts[b], kBuckets - 1) + 1];
-  for (std::uint32_t c = 1; c <= kBuckets; ++c) start[c] += start[c - 1];
-  for (std::uint32_t b = first; b < end; ++b) order[start[std::min(counts[b], kBuckets - 1)]++] = b;
-  std::uint32_t n = end - first;
-  for (; n % 4 != 0; ++n) order[n] = order[n - 1];
-  return n;
-}
-
-// The shared SIMD build, then the order of every whole batch of the range,
-// so that the step passes until the next build need not sort (sorting every
-// step cost 8 % of the SSE step). A batch cut by the range's end, the last of
-// the balls, is sorted by the step itself.
-std::uint32_t build_lists_and_batch_order(const ListBuild& b, std::uint32_t begin, std::uint32_t end) {
-  const std::uint32_t longest = build_lists(b, begin, end);
-  for (std::uint32_t batch = begin; batch + kStepBatch <= end; batch += kStepBatch)
-    by_neighbour_count(b.counts, batch, batch + kStepBatch, b.batch_order + batch);
-  return longest;
-}
-
 // Sum over each ball's neighbours of the spring-dashpot force, as (Fx, Fy, Fz, 0).
 void pair_forces(const StepArrays& arrays, const ContactModel& m, std::uint32_t first, std::uint32_t end,
                  Float4* forces) {
   const StepArrays s = arrays;  // a local copy: the stores to forces cannot change it (see step)
   const F4 k = F4::splat(m.k), neg_damping = F4::splat(-m.damping_factor);
   const F4 tiny = F4::splat(1e-12f);  // squared distance floor: coincident centres stay finite
-  std::uint32_t sorted_here[kStepBatch + 3];
-  const bool whole = end - first == kStepBatch;
-  const std::uint32_t* order = whole ? s.batch_order + first : sorted_here;
-  const std::uint32_t grouped = whole ? kStepBatch : by_neighbour_count(s.neighbour_count, first, end, sorted_here);
-  for (const std::uint32_t* group = order; group < order + grouped; group += 4) {
+  BatchOrder order(s, first, end, 4);
+  for (const std::uint32_t* group = order.begin(); group < order.end(); group += 4) {
     const std::uint32_t a = group[0], b = group[1], c = group[2], d = group[3];
     F4 xi, yi, zi, ri, vxi, vyi, vzi, mi;
     simd::transpose(F4::load(s.pos[a]), F4::load(s.pos[b]), F4::load(s.pos[c]), F4::load(s.pos[d]), xi, yi, zi, ri);
