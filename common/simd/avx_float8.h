@@ -24,9 +24,6 @@ struct F8 {
 
   static F8 splat(float s) { return {_mm256_set1_ps(s)}; }
   static F8 zero() { return {_mm256_setzero_ps()}; }
-  // The same four lanes in both halves.
-  static F8 both(F4 a) { return {_mm256_set_m128(a.v, a.v)}; }
-  static F8 halves(F4 lo, F4 hi) { return {_mm256_set_m128(hi.v, lo.v)}; }
   // lo in the low half, hi in the high half: two aligned loads.
   static F8 load_pair(const Float4& lo, const Float4& hi) {
     return {_mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(&lo.x)), _mm_load_ps(&hi.x), 1)};
@@ -45,16 +42,16 @@ inline F8 operator-(F8 a, F8 b) { return {_mm256_sub_ps(a.v, b.v)}; }
 inline F8 operator*(F8 a, F8 b) { return {_mm256_mul_ps(a.v, b.v)}; }
 inline F8 operator/(F8 a, F8 b) { return {_mm256_div_ps(a.v, b.v)}; }
 inline F8& operator+=(F8& a, F8 b) { return a = a + b; }
+inline F8& operator-=(F8& a, F8 b) { return a = a - b; }
 inline F8 sqrt(F8 a) { return {_mm256_sqrt_ps(a.v)}; }
 // a * b + c in one rounding.
 inline F8 mul_add(F8 a, F8 b, F8 c) { return {_mm256_fmadd_ps(a.v, b.v, c.v)}; }
-// c - a * b in one rounding.
-inline F8 neg_mul_add(F8 a, F8 b, F8 c) { return {_mm256_fnmadd_ps(a.v, b.v, c.v)}; }
-// 1/sqrt(a) to about 1e-7 relative: the 12-bit estimate plus one Newton step.
-inline F8 rsqrt(F8 a) {
+// -1/sqrt(a) to about 1e-7 relative: the 12-bit estimate plus one Newton
+// step, negated as the SSE version is (sse_float4.h).
+inline F8 neg_rsqrt(F8 a) {
   __m256 r = _mm256_rsqrt_ps(a.v);
   __m256 half_a_r2 = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), a.v), _mm256_mul_ps(r, r));
-  return {_mm256_mul_ps(r, _mm256_sub_ps(_mm256_set1_ps(1.5f), half_a_r2))};
+  return {_mm256_mul_ps(r, _mm256_sub_ps(half_a_r2, _mm256_set1_ps(1.5f)))};
 }
 inline F8 max(F8 a, F8 b) { return {_mm256_max_ps(a.v, b.v)}; }
 inline M8 operator<(F8 a, F8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_LT_OQ)}; }
@@ -63,19 +60,6 @@ inline M8 operator|(M8 a, M8 b) { return {_mm256_or_ps(a.v, b.v)}; }
 inline bool any(M8 m) { return _mm256_movemask_ps(m.v) != 0; }
 // Lanes where the mask is off become zero.
 inline F8 keep(M8 m, F8 a) { return {_mm256_and_ps(m.v, a.v)}; }
-
-// Zero the w lane of each half.
-inline F8 xyz_only(F8 a) { return {_mm256_blend_ps(a.v, _mm256_setzero_ps(), 0b10001000)}; }
-
-// Dot product of the x, y, z lanes of each half, broadcast across that half.
-inline F8 dot3(F8 a, F8 b) { return {_mm256_dp_ps(a.v, b.v, 0x7F)}; }
-
-// Lane L of each half, broadcast across that half (the same value in both
-// halves when a came from F8::both).
-template <int L>
-inline F8 broadcast(F8 a) {
-  return {_mm256_shuffle_ps(a.v, a.v, _MM_SHUFFLE(L, L, L, L))};
-}
 
 // Four rows of two Float4 each become columns: xs, ys, zs, ws of the eight.
 inline void transpose(F8 a, F8 b, F8 c, F8 d, F8& xs, F8& ys, F8& zs, F8& ws) {

@@ -25,7 +25,6 @@ struct F4 {
   static F4 splat(float s) { return {_mm_set1_ps(s)}; }
   static F4 zero() { return {_mm_setzero_ps()}; }
   static F4 load(const Float4& f) { return {_mm_load_ps(&f.x)}; }
-  static F4 set(float x, float y, float z, float w) { return {_mm_setr_ps(x, y, z, w)}; }
   void store(Float4& f) const { _mm_store_ps(&f.x, v); }
 };
 
@@ -47,18 +46,19 @@ inline F4 neg_rsqrt(F4 a) {
   return {_mm_mul_ps(r, _mm_sub_ps(half_a_r2, _mm_set1_ps(1.5f)))};
 }
 inline F4 max(F4 a, F4 b) { return {_mm_max_ps(a.v, b.v)}; }
+// a * b + c, rounded twice as in the scalar twin: SSE4.1 has no fused form.
+inline F4 mul_add(F4 a, F4 b, F4 c) { return a * b + c; }
+// The largest of the four lanes.
+inline float max_lane(F4 a) {
+  const __m128 m = _mm_max_ps(a.v, _mm_movehl_ps(a.v, a.v));  // max(0, 2), max(1, 3)
+  return _mm_cvtss_f32(_mm_max_ss(m, _mm_shuffle_ps(m, m, 1)));
+}
 inline M4 operator<(F4 a, F4 b) { return {_mm_cmplt_ps(a.v, b.v)}; }
 inline M4 operator>(F4 a, F4 b) { return {_mm_cmpgt_ps(a.v, b.v)}; }
 inline M4 operator|(M4 a, M4 b) { return {_mm_or_ps(a.v, b.v)}; }
 inline bool any(M4 m) { return _mm_movemask_ps(m.v) != 0; }
 // Lanes where the mask is off become zero.
 inline F4 keep(M4 m, F4 a) { return {_mm_and_ps(m.v, a.v)}; }
-
-// Zero the w lane.
-inline F4 xyz_only(F4 a) { return {_mm_blend_ps(a.v, _mm_setzero_ps(), 0b1000)}; }
-
-// Dot product of the x, y, z lanes, broadcast to all four lanes.
-inline F4 dot3(F4 a, F4 b) { return {_mm_dp_ps(a.v, b.v, 0x7F)}; }
 
 // Lane L of a, broadcast to all four lanes.
 template <int L>
@@ -111,12 +111,6 @@ inline void compress_store(I4 a, int mask, std::uint32_t* out) {
   };
   const __m128i gather = _mm_load_si128(reinterpret_cast<const __m128i*>(kGather[mask]));
   _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm_shuffle_epi8(a.v, gather));
-}
-
-inline float lane(F4 a, int i) {
-  alignas(16) float f[4];
-  _mm_store_ps(f, a.v);
-  return f[i];
 }
 
 }  // namespace FISHTANK_SIMD_ISA_NAMESPACE

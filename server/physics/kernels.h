@@ -3,8 +3,9 @@
 // twins with the same signatures:
 //   kernels_scalar.cpp  plain C++, one pair at a time (the reference)
 //   kernels_sse.cpp     SSE4.1, four balls and one neighbour of each at a time
-//   kernels_avx2.cpp    AVX2 + FMA, two balls and four neighbours of each at a time (a third level)
-// The two SIMD files share their per-ball code (kernels_simd_ball.h).
+//   kernels_avx2.cpp    AVX2 + FMA, eight balls and one neighbour of each at a time (a third level)
+// The two SIMD files share their passes, written once for either vector
+// type (kernels_simd_ball.h); each says how to gather and scatter its lanes.
 // A build picks one set at compile time (see server/main.cpp); the tests hold
 // them all so they can compare them.
 //

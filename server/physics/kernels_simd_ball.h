@@ -1,11 +1,14 @@
 #pragma once
-// The parts of the SIMD kernels that work per ball: walls, player spheres,
-// the step pass around the neighbour sums that each kernel file supplies, and
-// the neighbour-list build.
+// What the two SIMD kernel files share: the step and acceleration passes,
+// written once for a vector type V, and the neighbour-list build.
 //
-// For the per-ball arithmetic (walls, kick, drift) a vector V carries one
-// ball in four lanes (F4, kernels_sse.cpp) or two balls, one per 128-bit half
-// (F8, kernels_avx2.cpp); BallLanes<V> says how to load and store them.
+// A vector carries a group of balls, one per lane: four in F4
+// (kernels_sse.cpp), eight in F8 (kernels_avx2.cpp); each file says how to
+// gather and scatter its lanes (Lanes<V>). For its neighbour sums each lane
+// walks its own ball's list, one neighbour per block, so a group costs as
+// many blocks as its longest list: groups are formed of balls with similar
+// neighbour counts (BatchOrder). Walls, player spheres, kick and drift then
+// serve the whole group per instruction too.
 //
 // Both files include this header and are compiled with different -m flags, so
 // everything here has internal linkage: each gets its own copy in its own
@@ -21,141 +24,6 @@ namespace {
 
 using simd::F4;
 using simd::M4;
-
-// How a vector type holds balls. A pass visits balls first..last together
-// (last == first when a chunk's last ball has no partner: it is then carried
-// twice and stored twice, with the same result).
-template <class V>
-struct BallLanes;
-
-template <>
-struct BallLanes<F4> {
-  static constexpr std::uint32_t kBalls = 1;
-  static F4 both(F4 a) { return a; }
-  static F4 load(const Float4* a, std::uint32_t first, std::uint32_t) { return F4::load(a[first]); }
-  static void store(F4 v, Float4* a, std::uint32_t first, std::uint32_t) { v.store(a[first]); }
-  template <class PerBall>
-  static F4 each_ball(PerBall f, F4 p, F4 v) {
-    return f(p, v);
-  }
-  static float lane0_max(F4 a) { return simd::lane(a, 0); }  // lane 0, the largest over the balls carried
-};
-
-// Kinematic player spheres: the ball's effective mass is its own mass.
-inline F4 player_forces(const StepArrays& s, const ContactModel& m, F4 pi, F4 vi) {
-  F4 force = F4::zero();
-  const float ri = simd::lane(pi, 3);
-  const F4 c = F4::splat(m.damping_factor) * sqrt(simd::broadcast<3>(vi));
-  for (int p = 0; p < s.players; ++p) {
-    F4 d = simd::xyz_only(pi - F4::load(s.player_pos[p]));
-    float reach = ri + s.player_pos[p].w;
-    F4 d2 = dot3(d, d);
-    if (simd::lane(d2, 0) >= reach * reach) continue;
-    F4 dist = max(sqrt(d2), F4::splat(1e-6f));
-    F4 n = d / dist;
-    F4 v_n = dot3(vi - F4::load(s.player_vel[p]), n);
-    force += (F4::splat(m.k) * (F4::splat(reach) - dist) - c * v_n) * n;
-  }
-  return force;
-}
-
-// Six half-space walls, one lane per axis: below the minimum face the force
-// points +axis, above the maximum face -axis; both grow with depth. The w
-// lanes of the faces are chosen so the w lane never registers a contact.
-template <class V>
-struct Walls {
-  V lo, hi;
-  explicit Walls(const TankBounds& t)
-      : lo(BallLanes<V>::both(F4::set(t.min.x, t.min.y, t.min.z, -1e30f))),
-        hi(BallLanes<V>::both(F4::set(t.max.x, t.max.y, t.max.z, 1e30f))) {}
-};
-
-template <class V>
-inline V wall_forces(const ContactModel& m, const Walls<V>& walls, V pi, V vi) {
-  const V r = simd::broadcast<3>(pi);
-  const V below = walls.lo + r - pi;
-  const V above = pi + r - walls.hi;
-  const auto in_floor_or_wall = below > V::zero(), in_ceiling_or_wall = above > V::zero();
-  if (!simd::any(in_floor_or_wall | in_ceiling_or_wall)) return V::zero();  // most balls touch no wall
-  const V k = V::splat(m.k);
-  const V c = V::splat(m.damping_factor) * sqrt(simd::broadcast<3>(vi));
-  const V v = simd::xyz_only(vi);
-  return keep(in_floor_or_wall, k * below - c * v) - keep(in_ceiling_or_wall, k * above + c * v);
-}
-
-// PairForces(s, m, first, end, forces) sums the spring-dashpot forces of the
-// neighbours of each ball b in [first, end), a batch of at most kStepBatch, into
-// forces[b - first] as (Fx, Fy, Fz, 0). Each kernel file supplies its own.
-using PairForcesFn = void (*)(const StepArrays&, const ContactModel&, std::uint32_t, std::uint32_t, Float4*);
-
-// a = F / m + g for the balls in p (positions) and v (half-step velocities),
-// given the sums of their neighbours' forces: adds walls and player spheres.
-template <class V>
-[[gnu::always_inline]] inline V acceleration(const StepArrays& s, const ContactModel& m, const Walls<V>& walls, V p,
-                                             V v, V pair_force) {
-  V force = pair_force + wall_forces(m, walls, p, v);
-  if (s.players > 0) force += BallLanes<V>::each_ball([&](F4 pi, F4 vi) { return player_forces(s, m, pi, vi); }, p, v);
-  // force.w == 0, so a.w == 0
-  return force / simd::broadcast<3>(v) + BallLanes<V>::both(F4::set(0.0f, -m.gravity, 0.0f, 0.0f));
-}
-
-// Balls are stepped in batches of kStepBatch (kernels.h): first the neighbour
-// sums of the whole batch, then the rest for each ball. Neither loop then
-// keeps the other's values in registers, and the neighbour loops of a batch
-// run back to back: faster than one loop doing both, although it executes a
-// few more instructions (technical report, section 4).
-// per_balls(first, last, pair_force) gets the balls of V one after another.
-template <class V, PairForcesFn PairForces, class PerBalls>
-[[gnu::always_inline]] inline void for_each_batch(const StepArrays& s, const ContactModel& m, std::uint32_t begin,
-                                                  std::uint32_t end, PerBalls per_balls) {
-  using Lanes = BallLanes<V>;
-  alignas(32) Float4 pair_force[kStepBatch];
-  for (std::uint32_t batch = begin, last_of_batch; batch < end; batch = last_of_batch) {
-    last_of_batch = batch_end(batch, end);
-    PairForces(s, m, batch, last_of_batch, pair_force);
-    for (std::uint32_t first = batch; first < last_of_batch; first += Lanes::kBalls) {
-      const std::uint32_t last = std::min(first + Lanes::kBalls, last_of_batch) - 1;
-      per_balls(first, last, Lanes::load(pair_force, first - batch, last - batch));
-    }
-  }
-}
-
-template <class V, PairForcesFn PairForces>
-float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t begin, std::uint32_t end) {
-  using Lanes = BallLanes<V>;
-  // Local copies: stores through the output pointers cannot change them, so
-  // pointers and constants stay in registers instead of being reloaded per ball.
-  const StepArrays s = arrays;
-  const ContactModel m = model;
-  const V half_dt = V::splat(m.half_dt);
-  const V dt_xyz = Lanes::both(F4::set(m.dt, m.dt, m.dt, 0.0f));  // keeps the radius in w
-  const Walls<V> walls(m.tank);
-  V max_d2 = V::zero();
-  for_each_batch<V, PairForces>(s, m, begin, end, [&](std::uint32_t first, std::uint32_t last, V pair_force) {
-    const V p = Lanes::load(s.pos, first, last);
-    const V vh = Lanes::load(s.vel_half, first, last);
-    const V a = acceleration(s, m, walls, p, vh, pair_force);
-    const V v = vh + a * half_dt;
-    const V vh_next = v + a * half_dt;
-    const V p_next = p + vh_next * dt_xyz;
-    Lanes::store(v, s.vel, first, last);
-    Lanes::store(vh_next, s.vel_half_next, first, last);
-    Lanes::store(p_next, s.pos_next, first, last);
-    const V d = p_next - Lanes::load(s.pos_at_build, first, last);  // w lanes are both the radius
-    max_d2 = max(max_d2, dot3(d, d));
-  });
-  return Lanes::lane0_max(max_d2);
-}
-
-template <class V, PairForcesFn PairForces>
-void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin, std::uint32_t end) {
-  using Lanes = BallLanes<V>;
-  const Walls<V> walls(m.tank);
-  for_each_batch<V, PairForces>(s, m, begin, end, [&](std::uint32_t first, std::uint32_t last, V pair_force) {
-    const V p = Lanes::load(s.pos, first, last), v = Lanes::load(s.vel_half, first, last);
-    Lanes::store(acceleration(s, m, walls, p, v, pair_force), acc, first, last);
-  });
-}
 
 // Lists four candidates at a time: a cell range is contiguous in the sorted
 // arrays, so four consecutive balls are tested at once and the indices of
@@ -245,6 +113,174 @@ class BatchOrder {
   const std::uint32_t* begin_;
   std::uint32_t length_;
 };
+
+// Lanes<V> (each kernel file) says how a vector holds a group of balls, one
+// per lane: kCount lanes; load(rows, j, x, y, z, w) gathers rows[j[0..]] into
+// lanes; store(x, y, z, w, rows, j) scatters them back; largest(a) is the
+// largest lane.
+template <class V>
+struct Lanes;
+
+// A group's balls, one per lane.
+template <class V>
+struct GroupBalls {
+  V x, y, z, r;  // position, radius
+  V vx, vy, vz;  // half-step velocity
+  V m;           // mass
+};
+
+// Sum over each lane's neighbours of the spring-dashpot force, into fx, fy, fz.
+// Each lane walks its own ball's list, one neighbour per block, and adds in list
+// order, as the scalar twin does. d and dv point from ball i to its neighbour,
+// the opposite of the scalar twin's, so SSE's two-operand subtract works in
+// place on the gathered neighbour lanes with no copies; the negations are exact
+// and cancel in pairs, so every value is the scalar formula's (up to the
+// estimates).
+template <class V>
+[[gnu::always_inline]] inline void neighbour_forces(const StepArrays& s, const ContactModel& m,
+                                                    const std::uint32_t* group, const GroupBalls<V>& i, V& fx, V& fy,
+                                                    V& fz) {
+  constexpr std::uint32_t kCount = Lanes<V>::kCount;
+  const V k = V::splat(m.k), neg_damping = V::splat(-m.damping_factor);
+  const V tiny = V::splat(1e-12f);  // squared distance floor: coincident centres stay finite
+  // Past its end, a shorter list's row holds the ghost: it touches nothing.
+  const std::uint32_t* row[kCount];
+  std::uint32_t longest = 0;
+  for (std::uint32_t l = 0; l < kCount; ++l) {
+    row[l] = s.neighbours + std::size_t(group[l]) * s.stride;
+    longest = std::max(longest, s.neighbour_count[group[l]]);
+  }
+  fx = fy = fz = V::zero();
+  for (std::uint32_t n = 0; n < longest; ++n) {
+    std::uint32_t j[kCount];
+    for (std::uint32_t l = 0; l < kCount; ++l) j[l] = row[l][n];
+    V dx, dy, dz, rj;
+    Lanes<V>::load(s.pos, j, dx, dy, dz, rj);
+    dx -= i.x, dy -= i.y, dz -= i.z;
+    const V d2 = mul_add(dz, dz, mul_add(dy, dy, dx * dx));
+    const V reach = rj + i.r;
+    const auto touching = d2 < reach * reach;
+    // Velocities for every block: in a pile 99 % of blocks have a lane in contact.
+    V dvx, dvy, dvz, mj;
+    Lanes<V>::load(s.vel_half, j, dvx, dvy, dvz, mj);
+    dvx -= i.vx, dvy -= i.vy, dvz -= i.vz;
+    const V neg_inv_dist = simd::neg_rsqrt(max(d2, tiny));
+    const V neg_dist = d2 * neg_inv_dist;
+    const V v_n_dist = mul_add(dvz, dz, mul_add(dvy, dy, dvx * dx));  // v_n |d|
+    // sqrt(m_eff) = sqrt(mi mj / (mi + mj)) = mi mj / sqrt(mi mj (mi + mj)): one estimate, no reciprocal.
+    const V mi_mj = i.m * mj;
+    const V c = neg_damping * mi_mj * simd::neg_rsqrt(mi_mj * (i.m + mj));  // damping * sqrt(m_eff)
+    // f / |d| multiplies the unnormalised d: the normal is never formed.
+    const V f_over_dist = keep(touching, mul_add(c, v_n_dist * neg_inv_dist, k * (reach + neg_dist)) * neg_inv_dist);
+    fx = mul_add(f_over_dist, dx, fx);
+    fy = mul_add(f_over_dist, dy, fy);
+    fz = mul_add(f_over_dist, dz, fz);
+  }
+}
+
+// One axis of the six half-space walls: below the minimum face the force
+// points +axis, above the maximum face -axis; both grow with depth.
+template <class V>
+[[gnu::always_inline]] inline V wall_force(V k, V c, V p, V v, V r, float lo, float hi) {
+  const V below = V::splat(lo) + r - p;
+  const V above = p + r - V::splat(hi);
+  return keep(below > V::zero(), k * below - c * v) - keep(above > V::zero(), k * above + c * v);
+}
+
+// a = F / m + g for a group's balls: their neighbours' forces f, plus walls
+// and player spheres.
+template <class V>
+[[gnu::always_inline]] inline void acceleration(const StepArrays& s, const ContactModel& m, const GroupBalls<V>& i,
+                                                V& fx, V& fy, V& fz) {
+  const TankBounds& t = m.tank;
+  const V r = i.r;
+  const auto in_wall = (V::splat(t.min.x) + r > i.x) | (i.x + r > V::splat(t.max.x)) | (V::splat(t.min.y) + r > i.y) |
+                       (i.y + r > V::splat(t.max.y)) | (V::splat(t.min.z) + r > i.z) | (i.z + r > V::splat(t.max.z));
+  const bool near_player = s.players > 0;
+  if (simd::any(in_wall) || near_player) {  // most groups touch no wall
+    const V k = V::splat(m.k);
+    const V c = V::splat(m.damping_factor) * sqrt(i.m);  // walls and players are kinematic: m_eff = m
+    fx += wall_force(k, c, i.x, i.vx, r, t.min.x, t.max.x);
+    fy += wall_force(k, c, i.y, i.vy, r, t.min.y, t.max.y);
+    fz += wall_force(k, c, i.z, i.vz, r, t.min.z, t.max.z);
+    for (int p = 0; p < s.players; ++p) {
+      const Float4 pp = s.player_pos[p], pv = s.player_vel[p];
+      const V dx = i.x - V::splat(pp.x), dy = i.y - V::splat(pp.y), dz = i.z - V::splat(pp.z);
+      const V d2 = mul_add(dz, dz, mul_add(dy, dy, dx * dx));
+      const V reach = r + V::splat(pp.w);
+      const auto touching = d2 < reach * reach;
+      if (!simd::any(touching)) continue;
+      const V dist = max(sqrt(d2), V::splat(1e-6f));
+      const V inv_dist = V::splat(1.0f) / dist;
+      const V v_n =
+          ((i.vx - V::splat(pv.x)) * dx + (i.vy - V::splat(pv.y)) * dy + (i.vz - V::splat(pv.z)) * dz) * inv_dist;
+      const V f_over_dist = keep(touching, (k * (reach - dist) - c * v_n) * inv_dist);
+      fx = mul_add(f_over_dist, dx, fx);
+      fy = mul_add(f_over_dist, dy, fy);
+      fz = mul_add(f_over_dist, dz, fz);
+    }
+  }
+  fx = fx / i.m;
+  fy = fy / i.m - V::splat(m.gravity);
+  fz = fz / i.m;
+}
+
+// Each pass takes the balls of a batch (kStepBatch, kernels.h) in groups of
+// kCount by neighbour count (BatchOrder), one ball per lane: the neighbour
+// sums, then walls, players, kick and drift for the group's balls at once,
+// and the results scattered back to their rows. A padded group repeats a
+// ball: it is computed twice and stored twice, with the same result.
+template <class V, class PerGroup>
+[[gnu::always_inline]] inline void for_each_group(const StepArrays& s, std::uint32_t begin, std::uint32_t end,
+                                                  PerGroup per_group) {
+  constexpr std::uint32_t kCount = Lanes<V>::kCount;
+  for (std::uint32_t batch = begin, last_of_batch; batch < end; batch = last_of_batch) {
+    last_of_batch = batch_end(batch, end);
+    const BatchOrder order(s, batch, last_of_batch, kCount);
+    for (const std::uint32_t* group = order.begin(); group < order.end(); group += kCount) {
+      GroupBalls<V> i;
+      Lanes<V>::load(s.pos, group, i.x, i.y, i.z, i.r);
+      Lanes<V>::load(s.vel_half, group, i.vx, i.vy, i.vz, i.m);
+      per_group(group, i);
+    }
+  }
+}
+
+template <class V>
+float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t begin, std::uint32_t end) {
+  // Local copies: stores through the output pointers cannot change them, so
+  // pointers and constants stay in registers instead of being reloaded.
+  const StepArrays s = arrays;
+  const ContactModel m = model;
+  V max_d2 = V::zero();
+  for_each_group<V>(s, begin, end, [&](const std::uint32_t* group, const GroupBalls<V>& i) {
+    V ax, ay, az;
+    neighbour_forces(s, m, group, i, ax, ay, az);
+    acceleration(s, m, i, ax, ay, az);
+    const V half_dt = V::splat(m.half_dt), dt = V::splat(m.dt);
+    const V vx = mul_add(ax, half_dt, i.vx), vy = mul_add(ay, half_dt, i.vy), vz = mul_add(az, half_dt, i.vz);
+    Lanes<V>::store(vx, vy, vz, i.m, s.vel, group);
+    const V hx = mul_add(ax, half_dt, vx), hy = mul_add(ay, half_dt, vy), hz = mul_add(az, half_dt, vz);
+    Lanes<V>::store(hx, hy, hz, i.m, s.vel_half_next, group);
+    const V px = mul_add(hx, dt, i.x), py = mul_add(hy, dt, i.y), pz = mul_add(hz, dt, i.z);
+    Lanes<V>::store(px, py, pz, i.r, s.pos_next, group);
+    V bx, by, bz, br;
+    Lanes<V>::load(s.pos_at_build, group, bx, by, bz, br);
+    bx -= px, by -= py, bz -= pz;
+    max_d2 = max(max_d2, mul_add(bz, bz, mul_add(by, by, bx * bx)));
+  });
+  return Lanes<V>::largest(max_d2);
+}
+
+template <class V>
+void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin, std::uint32_t end) {
+  for_each_group<V>(s, begin, end, [&](const std::uint32_t* group, const GroupBalls<V>& i) {
+    V ax, ay, az;
+    neighbour_forces(s, m, group, i, ax, ay, az);
+    acceleration(s, m, i, ax, ay, az);
+    Lanes<V>::store(ax, ay, az, V::zero(), acc, group);
+  });
+}
 
 }  // namespace
 }  // namespace fishtank
