@@ -70,7 +70,7 @@ inline std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::u
 // computed twice and stored twice, with the same result. Returns the length.
 // Both SIMD kernels take one ball per lane and one neighbour of each per
 // block, so a group costs as many blocks as its longest list; grouping balls
-// of equal counts keeps the blocks full (kernels_sse.cpp).
+// of equal counts keeps the blocks full (see the top of this file).
 inline std::uint32_t by_neighbour_count(const std::uint32_t* counts, std::uint32_t first, std::uint32_t end,
                                         std::uint32_t lanes, std::uint32_t* order) {
   constexpr std::uint32_t kBuckets = 32;  // longer lists share the last bucket: only the grouping is coarser
