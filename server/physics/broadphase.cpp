@@ -52,7 +52,7 @@ void NeighbourList::sort(const Float4* pos, std::uint32_t n, std::vector<std::ui
 }
 
 void NeighbourList::reserve(std::uint32_t n, std::uint32_t stride) {
-  stride_ = padded_neighbour_count(std::max(stride, kListPadding), kListPadding);
+  stride_ = std::max(stride, 1u);
   neighbours_.resize(std::size_t(n) * stride_);
   counts_.resize(n);
   batch_order_.resize(n);

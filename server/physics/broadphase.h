@@ -47,19 +47,13 @@ struct ListBuild {
   std::uint32_t* neighbours;  // out: ball i's list at i * stride, ghost-padded
   std::uint32_t* counts;      // out: the true count, which may exceed stride
   std::uint32_t stride;
-  std::uint32_t* batch_order;  // out, SSE build only: per step batch, its balls by count (kernels_sse.cpp)
+  std::uint32_t* batch_order;  // out, SIMD builds only: per step batch, its balls by count (kernels_simd_ball.h)
 };
 
-// Strides are a multiple of the four neighbours a SIMD kernel takes per ball
-// and block, and the rest of each ball's row holds the ghost's index, so a
-// kernel reads whole blocks with no tail loop, and the AVX2 kernel, which
-// walks two balls' rows side by side, reads ghosts where the shorter one ends.
-constexpr std::uint32_t kListPadding = 4;
-inline std::uint32_t padded_neighbour_count(std::uint32_t count, std::uint32_t lanes) {
-  return (count + lanes - 1) / lanes * lanes;
-}
-
-// Ball i's count neighbours are in place: record the count and fill the row with the ghost.
+// Ball i's count neighbours are in place: record the count and fill the rest
+// of the row with the ghost's index. The SIMD kernels walk the rows of a group
+// of balls side by side, as far as the group's longest list, and read ghosts
+// where a shorter one has ended.
 inline std::uint32_t finish_list(const ListBuild& b, std::uint32_t i, std::uint32_t count) {
   b.counts[i] = count;
   std::uint32_t* list = b.neighbours + std::size_t(i) * b.stride;

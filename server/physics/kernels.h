@@ -58,15 +58,16 @@ struct Kernels {
                         std::uint32_t end);
   // Neighbour lists of balls [begin, end) (see broadphase.h). Returns the longest.
   // begin is a multiple of kStepBatch, and end is one too or the last ball's
-  // index + 1, as in every WorkerPool chunk of the world (the SSE build writes
+  // index + 1, as in every WorkerPool chunk of the world (the SIMD builds write
   // data per batch for the step passes that follow).
   std::uint32_t (*build_lists)(const ListBuild& b, std::uint32_t begin, std::uint32_t end);
 };
 
 // Every step kernel works through its chunk in batches of this many balls,
-// which start at multiples of kStepBatch: the neighbour sums of the whole
-// batch first, then walls, players, kick and drift for each ball (see
-// kernels_simd_ball.h for why).
+// which start at multiples of kStepBatch: the scalar twin sums the neighbour
+// forces of the whole batch, then does walls, players, kick and drift for each
+// ball; the SIMD kernels take the batch in groups of balls with similar
+// neighbour counts (kernels_simd_ball.h).
 constexpr std::uint32_t kStepBatch = 64;
 
 // The end of the batch that holds ball `first`, within [.., end).

@@ -88,7 +88,8 @@ float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
   const StepArrays s = arrays;
   const ContactModel m = model;
   float max_d2 = 0.0f;
-  // Batches, as in the SIMD kernels: the neighbour sums of a batch, then the rest per ball.
+  // The neighbour sums of a batch, then the rest per ball: one loop doing both
+  // keeps the wall and integration values live across the neighbour loop.
   Float4 pair_force[kStepBatch];
   for (std::uint32_t batch = begin, last_of_batch; batch < end; batch = last_of_batch) {
     last_of_batch = batch_end(batch, end);

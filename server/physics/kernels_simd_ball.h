@@ -196,8 +196,7 @@ template <class V>
   const V r = i.r;
   const auto in_wall = (V::splat(t.min.x) + r > i.x) | (i.x + r > V::splat(t.max.x)) | (V::splat(t.min.y) + r > i.y) |
                        (i.y + r > V::splat(t.max.y)) | (V::splat(t.min.z) + r > i.z) | (i.z + r > V::splat(t.max.z));
-  const bool near_player = s.players > 0;
-  if (simd::any(in_wall) || near_player) {  // most groups touch no wall
+  if (simd::any(in_wall) || s.players > 0) {  // most groups touch no wall
     const V k = V::splat(m.k);
     const V c = V::splat(m.damping_factor) * sqrt(i.m);  // walls and players are kinematic: m_eff = m
     fx += wall_force(k, c, i.x, i.vx, r, t.min.x, t.max.x);

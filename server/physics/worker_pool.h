@@ -9,7 +9,7 @@
 // through its own part of the arrays and results never depend on timing.
 // Chunks start at multiples of a granule, so every pass over the same count
 // puts each granule-sized block of items on one thread, whatever the number
-// of threads (the SSE kernels keep per-block data from one pass to the next). A
+// of threads (the SIMD kernels keep per-block data from one pass to the next). A
 // phase lasts tens of microseconds in benchmark mode, so workers spin briefly
 // before sleeping on a condition variable: a wake-up from spinning costs well
 // under a microsecond, one from sleep several. With one thread, run() is a

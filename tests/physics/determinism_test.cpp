@@ -49,9 +49,9 @@ TEST_CASE("the AVX2 level's state is bit-identical for 1, 2 and 3 threads", "[ph
     WARN("this processor has no AVX2; nothing to compare");
     return;
   }
-  // The AVX2 kernel carries two neighbouring balls per vector and sums with
-  // fused multiply-adds; three threads give chunks of unequal lengths
-  // (chunks start at multiples of the 64-ball step batch).
+  // The AVX2 kernel carries eight balls per vector and sums with fused
+  // multiply-adds; three threads give chunks of unequal lengths (chunks start
+  // at multiples of the 64-ball step batch).
   const std::uint64_t one = run(kAvx2Kernels, 1);
   CHECK(run(kAvx2Kernels, 2) == one);
   CHECK(run(kAvx2Kernels, 3) == one);
@@ -116,9 +116,9 @@ std::vector<std::uint32_t> step_in_ranges(const Kernels& kernels, const std::vec
 }  // namespace
 
 TEST_CASE("a ball's step does not depend on which balls share its vector", "[physics][determinism]") {
-  // Ranges that start at odd balls and cut batches short: the AVX2 kernel then
-  // pairs other balls in its vectors, and the SSE kernel groups other balls by
-  // count (it sorts cut batches itself) than when it steps all 300 at once.
+  // Ranges that start at odd balls and cut batches short: each SIMD kernel then
+  // sorts those batches itself and groups other balls in its vectors than
+  // when it steps all 300 at once.
   std::vector<const Kernels*> simd{&kSseKernels};
   if (cpu_has_avx2()) simd.push_back(&kAvx2Kernels);
   for (const Kernels* kernels : simd) {
