@@ -117,7 +117,7 @@ void build_lists(benchmark::State& state, const fishtank::Kernels& kernels) {
   list.sort(unsorted.data(), n, order);
   fishtank::AlignedVector<fishtank::Float4> pos(unsorted);
   for (std::uint32_t k = 0; k < n; ++k) pos[k] = unsorted[order[k]];
-  list.reserve(n, 32);
+  list.reserve(n, 32, kernels.list_lanes);
   const fishtank::ListBuild build = list.build_view(pos.data(), n);
   for (auto _ : state) benchmark::DoNotOptimize(kernels.build_lists(build, 0, n));
   report_block_counts(state, list.counts(), n);

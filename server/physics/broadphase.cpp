@@ -51,11 +51,13 @@ void NeighbourList::sort(const Float4* pos, std::uint32_t n, std::vector<std::ui
   }
 }
 
-void NeighbourList::reserve(std::uint32_t n, std::uint32_t stride) {
+void NeighbourList::reserve(std::uint32_t n, std::uint32_t stride, std::uint32_t lanes) {
   stride_ = std::max(stride, 1u);
-  neighbours_.resize(std::size_t(n) * stride_);
+  lanes_ = lanes;
+  // The last batch's groups may repeat a ball to fill their lanes.
+  neighbours_.resize((std::size_t(n) + lanes - 1) * stride_);
   counts_.resize(n);
-  batch_order_.resize(n);
+  batch_order_.resize(std::size_t(n) + lanes - 1);
 }
 
 ListBuild NeighbourList::build_view(const Float4* pos, std::uint32_t n) {

@@ -10,9 +10,10 @@
 //            one block's layer away in memory, not a whole tank's. A tank at
 //            most kBlockCells wide is one block: plain x, y, z order.
 //   build:   for each ball, every other ball closer than r_i + r_j + skin
-//            (a kernel, Kernels::build_lists). Each ball writes only its own
-//            list, so chunks build in parallel, and lists come out the same
-//            for any thread count.
+//            (a kernel, Kernels::build_lists). Each batch of balls writes
+//            only its own stretch of the lists (the layout below), so chunks
+//            build in parallel, and lists come out the same for any thread
+//            count.
 //
 // The list stays valid until some ball has moved more than skin / 2 since the
 // build (two balls closing by skin / 2 each could then touch unseen); the
@@ -26,6 +27,31 @@
 #include "common/tank.h"
 
 namespace fishtank {
+
+// The lists' layout. Balls are taken in batches of kStepBatch, which start
+// at multiples of it (every WorkerPool chunk of the world does too), and a
+// batch keeps its lists from neighbours + first * stride, packed: the batch's
+// balls in groups of `lanes` (in batch_order), each group as many blocks as
+// its longest list, a block holding the next neighbour of each ball of the
+// group, in list order, or the ghost (index n) for a list that has ended.
+// With one lane (the scalar twin, batch order = ball order) that is each
+// ball's list after the previous ball's; with four or eight (the SIMD twins)
+// a block is one vector's neighbours, contiguous, and the batch's groups are
+// balls of similar counts (kernels_simd_ball.h). stride bounds a list's
+// length: it sizes the room, not the layout, so a batch's lists fill one
+// stretch of memory as long as they are, however large the stride.
+constexpr std::uint32_t kStepBatch = 64;
+
+// The end of the batch that holds ball `first`, within [.., end).
+inline std::uint32_t batch_end(std::uint32_t first, std::uint32_t end) {
+  return std::min(end, (first / kStepBatch + 1) * kStepBatch);
+}
+
+// Balls in a batch's groups: count rounded up to a multiple of lanes (the
+// last group of a short batch repeats its last ball).
+inline std::uint32_t grouped_length(std::uint32_t count, std::uint32_t lanes) {
+  return (count + lanes - 1) / lanes * lanes;
+}
 
 // What a list build reads and writes: the cell-sorted balls and the grid, and
 // the lists to fill. The build itself is a kernel (kernels.h), scalar or SIMD.
@@ -44,22 +70,19 @@ struct ListBuild {
   int nx, ny, nz;                   // cells per axis
   int block;                        // cells per block in x
   float skin;
-  std::uint32_t* neighbours;  // out: ball i's list at i * stride, ghost-padded
-  std::uint32_t* counts;      // out: the true count, which may exceed stride
-  std::uint32_t stride;
-  std::uint32_t* batch_order;  // out, SIMD builds only: per step batch, its balls by count (kernels_simd_ball.h)
+  std::uint32_t* neighbours;   // out: the lists, laid out as above
+  std::uint32_t* counts;       // out: the true count, which may exceed stride
+  std::uint32_t stride;        // the most entries a list may store
+  std::uint32_t* batch_order;  // out: per batch, its balls in groups (room for lanes - 1 more at the end)
 };
 
-// Ball i's count neighbours are in place: record the count and fill the rest
-// of the row with the ghost's index. The SIMD kernels walk the rows of a group
-// of balls side by side, as far as the group's longest list, and read ghosts
-// where a shorter one has ended.
-inline std::uint32_t finish_list(const ListBuild& b, std::uint32_t i, std::uint32_t count) {
-  b.counts[i] = count;
-  std::uint32_t* list = b.neighbours + std::size_t(i) * b.stride;
-  std::fill(list + std::min(count, b.stride), list + b.stride, b.n);
-  return count;
-}
+// One ball's stored list: entry k is first[k * lanes].
+struct ListView {
+  const std::uint32_t* first;
+  std::uint32_t count;
+  std::uint32_t lanes;
+  std::uint32_t operator[](std::uint32_t k) const { return first[std::size_t(k) * lanes]; }
+};
 
 // Ghost slots after the last ball: a SIMD build reads up to three balls past
 // the end of a cell range, so arrays hold n + kGhostSlots entries, each a
@@ -106,13 +129,19 @@ class NeighbourList {
   // count says so: the caller then grows the stride and builds again.
   ListBuild build_view(const Float4* pos, std::uint32_t n);
 
-  // Room for `stride` neighbours of each of n balls.
-  void reserve(std::uint32_t n, std::uint32_t stride);
+  // Room for `stride` neighbours of each of n balls, laid out in groups of
+  // `lanes` (Kernels::list_lanes of the build that fills them).
+  void reserve(std::uint32_t n, std::uint32_t stride, std::uint32_t lanes);
 
   std::uint32_t stride() const { return stride_; }
   const std::uint32_t* neighbours() const { return neighbours_.data(); }
   const std::uint32_t* counts() const { return counts_.data(); }
   const std::uint32_t* batch_order() const { return batch_order_.data(); }
+
+  // Calls visit(i, ListView) once for each of the n balls of the last build,
+  // batch by batch in the layout's order.
+  template <class Visit>
+  void for_each_list(std::uint32_t n, Visit visit) const;
 
  private:
   CellCoord cell_of(const Float4& p) const;
@@ -127,9 +156,28 @@ class NeighbourList {
   std::vector<CellCoord> scratch_cell_;
   std::vector<std::uint32_t> scratch_number_;
   std::uint32_t stride_ = 0;
+  std::uint32_t lanes_ = 1;
   std::vector<std::uint32_t> neighbours_;
   std::vector<std::uint32_t> counts_;
   std::vector<std::uint32_t> batch_order_;
 };
+
+template <class Visit>
+void NeighbourList::for_each_list(std::uint32_t n, Visit visit) const {
+  for (std::uint32_t batch = 0; batch < n; batch += kStepBatch) {
+    const std::uint32_t* block = neighbours_.data() + std::size_t(batch) * stride_;
+    const std::uint32_t* group = batch_order_.data() + batch;
+    const std::uint32_t* const groups_end = group + grouped_length(batch_end(batch, n) - batch, lanes_);
+    for (; group < groups_end; group += lanes_) {
+      std::uint32_t blocks = 0;
+      for (std::uint32_t l = 0; l < lanes_; ++l) {
+        const std::uint32_t count = std::min(counts_[group[l]], stride_);
+        blocks = std::max(blocks, count);
+        if (l == 0 || group[l] != group[l - 1]) visit(group[l], ListView{block + l, count, lanes_});
+      }
+      block += std::size_t(blocks) * lanes_;
+    }
+  }
+}
 
 }  // namespace fishtank

@@ -17,7 +17,6 @@
 //   vel  = vel_half + a dt/2                 (the full step, what observers see)
 //   vel_half_next = vel + a dt/2,  pos_next = pos + vel_half_next dt
 
-#include <algorithm>
 #include <cstdint>
 
 #include "common/float4.h"
@@ -33,9 +32,8 @@ struct StepArrays {
   Float4* pos_next;        // out: position one step later
   Float4* vel_half_next;   // out: velocity half a step later
   const Float4* pos_at_build;
-  // Full neighbour list (each pair appears from both sides): ball i's
-  // neighbours are neighbours[i * stride, i * stride + count[i]), and the rest
-  // of the row holds a ghost's index (broadphase.h, finish_list).
+  // Full neighbour lists (each pair appears from both sides), as this
+  // kernel set's build laid them out (broadphase.h); no count exceeds stride.
   const std::uint32_t* neighbours;
   const std::uint32_t* neighbour_count;
   std::uint32_t stride;
@@ -46,34 +44,24 @@ struct StepArrays {
 };
 
 struct Kernels {
-  const char* variant;  // "scalar", "sse" or "avx2"
-  const char* simd;     // instruction set of the kernels
-  bool threaded;        // whether the build may use more than one thread
-  // The step for balls [begin, end). Returns the largest squared distance of
-  // pos_next from pos_at_build, which tells when the lists must be rebuilt.
+  const char* variant;       // "scalar", "sse" or "avx2"
+  const char* simd;          // instruction set of the kernels
+  bool threaded;             // whether the build may use more than one thread
+  std::uint32_t list_lanes;  // balls per group in the lists' layout (broadphase.h)
+  // Each pass takes balls [begin, end), where begin is a multiple of
+  // kStepBatch and end is one too or the last ball's index + 1, as in every
+  // WorkerPool chunk of the world: the lists are laid out per batch.
+  //
+  // The step. Returns the largest squared distance of pos_next from
+  // pos_at_build, which tells when the lists must be rebuilt.
   float (*step)(const StepArrays& s, const ContactModel& m, std::uint32_t begin, std::uint32_t end);
   // a = F(pos, vel_half) / m + g only, into acc: for a state whose forces are
   // not known yet (balls placed in contact). Writes none of s's outputs.
   void (*accelerations)(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin,
                         std::uint32_t end);
-  // Neighbour lists of balls [begin, end) (see broadphase.h). Returns the longest.
-  // begin is a multiple of kStepBatch, and end is one too or the last ball's
-  // index + 1, as in every WorkerPool chunk of the world (the SIMD builds write
-  // data per batch for the step passes that follow).
+  // Neighbour lists (see broadphase.h). Returns the longest.
   std::uint32_t (*build_lists)(const ListBuild& b, std::uint32_t begin, std::uint32_t end);
 };
-
-// Every step kernel works through its chunk in batches of this many balls,
-// which start at multiples of kStepBatch: the scalar twin sums the neighbour
-// forces of the whole batch, then does walls, players, kick and drift for each
-// ball; the SIMD kernels take the batch in groups of balls with similar
-// neighbour counts (kernels_simd_ball.h).
-constexpr std::uint32_t kStepBatch = 64;
-
-// The end of the batch that holds ball `first`, within [.., end).
-inline std::uint32_t batch_end(std::uint32_t first, std::uint32_t end) {
-  return std::min(end, (first / kStepBatch + 1) * kStepBatch);
-}
 
 // The second half of a step for one ball, in plain C++: the half kick from
 // the full-step velocity v with acceleration a, then the drift from p into

@@ -37,6 +37,6 @@ struct Lanes<F8> {
 
 }  // namespace
 
-const Kernels kAvx2Kernels{"avx2", "avx2+fma", true, step<F8>, accelerations<F8>, build_lists_and_batch_order};
+const Kernels kAvx2Kernels{"avx2", "avx2+fma", true, 8, step<F8>, accelerations<F8>, build_lists<8>};
 
 }  // namespace fishtank

@@ -26,11 +26,11 @@ inline float wall_force_1d(const ContactModel& m, float pos, float vel, float r,
 }
 
 // Sum of the spring-dashpot forces of ball i's neighbours, (Fx, Fy, Fz, 0).
-[[gnu::always_inline]] inline Float4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t i) {
+[[gnu::always_inline]] inline Float4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t i,
+                                                 const std::uint32_t* list) {
   const Float4 pi = s.pos[i];
   const Float4 vi = s.vel_half[i];
   float fx = 0.0f, fy = 0.0f, fz = 0.0f;
-  const std::uint32_t* list = s.neighbours + std::size_t(i) * s.stride;
   for (std::uint32_t n = 0; n < s.neighbour_count[i]; ++n) {
     const Float4& pj = s.pos[list[n]];
     float dx = pi.x - pj.x, dy = pi.y - pj.y, dz = pi.z - pj.z;
@@ -93,7 +93,10 @@ float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
   Float4 pair_force[kStepBatch];
   for (std::uint32_t batch = begin, last_of_batch; batch < end; batch = last_of_batch) {
     last_of_batch = batch_end(batch, end);
-    for (std::uint32_t i = batch; i < last_of_batch; ++i) pair_force[i - batch] = pair_forces(s, m, i);
+    // With one lane, a batch's lists follow each other (broadphase.h).
+    const std::uint32_t* list = s.neighbours + std::size_t(batch) * s.stride;
+    for (std::uint32_t i = batch; i < last_of_batch; list += s.neighbour_count[i++])
+      pair_force[i - batch] = pair_forces(s, m, i, list);
     for (std::uint32_t i = batch; i < last_of_batch; ++i) {
       const Float4 a = acceleration(s, m, i, pair_force[i - batch]);
       const Float4 vh = s.vel_half[i];
@@ -106,14 +109,21 @@ float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
 }
 
 void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin, std::uint32_t end) {
-  for (std::uint32_t i = begin; i < end; ++i) acc[i] = acceleration(s, m, i, pair_forces(s, m, i));
+  for (std::uint32_t batch = begin; batch < end; batch += kStepBatch) {
+    const std::uint32_t* list = s.neighbours + std::size_t(batch) * s.stride;
+    for (std::uint32_t i = batch; i < batch_end(batch, end); list += s.neighbour_count[i++])
+      acc[i] = acceleration(s, m, i, pair_forces(s, m, i, list));
+  }
 }
 
+// One lane: each batch's lists one after the other, in ball order (broadphase.h).
 std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t end) {
   std::uint32_t longest = 0;
+  std::uint32_t* list = nullptr;
   for (std::uint32_t i = begin; i < end; ++i) {
+    if (i % kStepBatch == 0) list = b.neighbours + std::size_t(i) * b.stride;
+    b.batch_order[i] = i;
     const Float4 pi = b.pos[i];
-    std::uint32_t* list = b.neighbours + std::size_t(i) * b.stride;
     std::uint32_t count = 0;
     for_each_neighbour_range(b, i, [&](std::uint32_t j_begin, std::uint32_t j_end) {
       for (std::uint32_t j = j_begin; j < j_end; ++j) {
@@ -125,13 +135,15 @@ std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t
         ++count;
       }
     });
-    longest = std::max(longest, finish_list(b, i, count));
+    b.counts[i] = count;
+    list += std::min(count, b.stride);
+    longest = std::max(longest, count);
   }
   return longest;
 }
 
 }  // namespace
 
-const Kernels kScalarKernels{"scalar", "none", false, step, accelerations, build_lists};
+const Kernels kScalarKernels{"scalar", "none", false, 1, step, accelerations, build_lists};
 
 }  // namespace fishtank

@@ -15,6 +15,7 @@
 // instruction set, and the linker can never hand AVX2 code to the SSE build.
 
 #include <algorithm>
+#include <vector>
 
 #include "common/simd/sse_float4.h"
 #include "server/physics/kernels.h"
@@ -25,52 +26,47 @@ namespace {
 using simd::F4;
 using simd::M4;
 
-// Lists four candidates at a time: a cell range is contiguous in the sorted
-// arrays, so four consecutive balls are tested at once and the indices of
-// those within reach are packed into the list with one byte shuffle, with no
-// branch per candidate (the scalar build mispredicts on most of them).
-inline std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t end) {
+// Ball i's list into list (at most b.stride entries); returns its true count.
+// Four candidates at a time: a cell range is contiguous in the sorted arrays,
+// so four consecutive balls are tested at once and the indices of those
+// within reach are packed into the list with one byte shuffle, with no branch
+// per candidate (the scalar build mispredicts on most of them).
+inline std::uint32_t list_of(const ListBuild& b, std::uint32_t i, std::uint32_t* list) {
   const F4 skin = F4::splat(b.skin);
-  std::uint32_t longest = 0;
-  for (std::uint32_t i = begin; i < end; ++i) {
-    const F4 pi = F4::load(b.pos[i]);
-    const F4 two_ri_skin = simd::broadcast<3>(pi) + simd::broadcast<3>(pi) + skin;
-    const simd::I4 self = simd::I4::splat(i);
-    std::uint32_t* list = b.neighbours + std::size_t(i) * b.stride;
-    std::uint32_t count = 0;
-    for_each_neighbour_range(b, i, [&](std::uint32_t j_begin, std::uint32_t j_end) {
-      const simd::I4 range_end = simd::I4::splat(j_end);
-      for (std::uint32_t j = j_begin; j < j_end; j += 4) {  // may read up to 3 ghosts past the end
-        F4 dx, dy, dz, ri_minus_rj;
-        simd::transpose(pi - F4::load(b.pos[j]), pi - F4::load(b.pos[j + 1]), pi - F4::load(b.pos[j + 2]),
-                        pi - F4::load(b.pos[j + 3]), dx, dy, dz, ri_minus_rj);
-        const F4 cutoff = two_ri_skin - ri_minus_rj;  // ri + rj + skin
-        const simd::I4 index = simd::I4::iota(j);
-        int found = bits((dx * dx + dy * dy + dz * dz < cutoff * cutoff) & (index < range_end) & (index != self));
-        if (found == 0) continue;
-        if (count + 4 > b.stride) {  // nearly full: one by one, counting on so the caller can grow the list
-          for (std::uint32_t lane = 0; lane < 4; ++lane, found >>= 1)
-            if (found & 1) {
-              if (count < b.stride) list[count] = j + lane;
-              ++count;
-            }
-          continue;
-        }
-        compress_store(index, found, list + count);
-        count += __builtin_popcount(found);
+  const F4 pi = F4::load(b.pos[i]);
+  const F4 two_ri_skin = simd::broadcast<3>(pi) + simd::broadcast<3>(pi) + skin;
+  const simd::I4 self = simd::I4::splat(i);
+  std::uint32_t count = 0;
+  for_each_neighbour_range(b, i, [&](std::uint32_t j_begin, std::uint32_t j_end) {
+    const simd::I4 range_end = simd::I4::splat(j_end);
+    for (std::uint32_t j = j_begin; j < j_end; j += 4) {  // may read up to 3 ghosts past the end
+      F4 dx, dy, dz, ri_minus_rj;
+      simd::transpose(pi - F4::load(b.pos[j]), pi - F4::load(b.pos[j + 1]), pi - F4::load(b.pos[j + 2]),
+                      pi - F4::load(b.pos[j + 3]), dx, dy, dz, ri_minus_rj);
+      const F4 cutoff = two_ri_skin - ri_minus_rj;  // ri + rj + skin
+      const simd::I4 index = simd::I4::iota(j);
+      int found = bits((dx * dx + dy * dy + dz * dz < cutoff * cutoff) & (index < range_end) & (index != self));
+      if (found == 0) continue;
+      if (count + 4 > b.stride) {  // nearly full: one by one, counting on so the caller can grow the list
+        for (std::uint32_t lane = 0; lane < 4; ++lane, found >>= 1)
+          if (found & 1) {
+            if (count < b.stride) list[count] = j + lane;
+            ++count;
+          }
+        continue;
       }
-    });
-    longest = std::max(longest, finish_list(b, i, count));
-  }
-  return longest;
+      compress_store(index, found, list + count);
+      count += __builtin_popcount(found);
+    }
+  });
+  return count;
 }
 
 // Balls first..end-1 of a batch, by neighbour count (a counting sort), padded
 // to a multiple of `lanes` with the last one repeated: a repeated ball is
 // computed twice and stored twice, with the same result. Returns the length.
-// Both SIMD kernels take one ball per lane and one neighbour of each per
-// block, so a group costs as many blocks as its longest list; grouping balls
-// of equal counts keeps the blocks full (see the top of this file).
+// A group costs as many blocks as its longest list; grouping balls of equal
+// counts keeps the blocks full (see the top of this file).
 inline std::uint32_t by_neighbour_count(const std::uint32_t* counts, std::uint32_t first, std::uint32_t end,
                                         std::uint32_t lanes, std::uint32_t* order) {
   constexpr std::uint32_t kBuckets = 32;  // longer lists share the last bucket: only the grouping is coarser
@@ -83,36 +79,40 @@ inline std::uint32_t by_neighbour_count(const std::uint32_t* counts, std::uint32
   return n;
 }
 
-// The SIMD build, then the order of every whole batch of the range, so that
-// the step passes until the next build need not sort (sorting every step cost
-// 8 % of the SSE step). A batch cut by the range's end, the last of the balls,
-// is sorted by the step itself. kStepBatch is a multiple of every lane count.
-inline std::uint32_t build_lists_and_batch_order(const ListBuild& b, std::uint32_t begin, std::uint32_t end) {
-  const std::uint32_t longest = build_lists(b, begin, end);
-  for (std::uint32_t batch = begin; batch + kStepBatch <= end; batch += kStepBatch)
-    by_neighbour_count(b.counts, batch, batch + kStepBatch, 1, b.batch_order + batch);
+// The lists of balls [begin, end), laid out for groups of kLanes balls
+// (broadphase.h): each batch's lists are found into rows of a scratch buffer
+// that stays in the cache, the batch is ordered by count, and each group's
+// rows are interleaved into blocks, the ghost where a list has ended. The
+// step then reads one contiguous block per vector of neighbours, and the
+// lists take as much memory as the groups need, not a stride per ball.
+template <std::uint32_t kLanes>
+std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t end) {
+  thread_local std::vector<std::uint32_t> rows;
+  rows.resize(std::size_t(kStepBatch) * b.stride);
+  std::uint32_t longest = 0;
+  for (std::uint32_t batch = begin, last_of_batch; batch < end; batch = last_of_batch) {
+    last_of_batch = batch_end(batch, end);
+    for (std::uint32_t i = batch; i < last_of_batch; ++i) {
+      b.counts[i] = list_of(b, i, rows.data() + std::size_t(i - batch) * b.stride);
+      longest = std::max(longest, b.counts[i]);
+    }
+    std::uint32_t* order = b.batch_order + batch;
+    const std::uint32_t grouped = by_neighbour_count(b.counts, batch, last_of_batch, kLanes, order);
+    std::uint32_t* block = b.neighbours + std::size_t(batch) * b.stride;
+    for (const std::uint32_t* group = order; group < order + grouped; group += kLanes) {
+      const std::uint32_t* row[kLanes];
+      std::uint32_t count[kLanes], blocks = 0;
+      for (std::uint32_t l = 0; l < kLanes; ++l) {
+        row[l] = rows.data() + std::size_t(group[l] - batch) * b.stride;
+        count[l] = std::min(b.counts[group[l]], b.stride);
+        blocks = std::max(blocks, count[l]);
+      }
+      for (std::uint32_t n = 0; n < blocks; ++n, block += kLanes)
+        for (std::uint32_t l = 0; l < kLanes; ++l) block[l] = n < count[l] ? row[l][n] : b.n;
+    }
+  }
   return longest;
 }
-
-// The balls of batch [first, end) by neighbour count, in groups of `lanes`
-// (at most 8): the order the list build wrote for a whole batch, or one
-// sorted here for a batch cut short.
-class BatchOrder {
- public:
-  BatchOrder(const StepArrays& s, std::uint32_t first, std::uint32_t end, std::uint32_t lanes)
-      : begin_(s.batch_order + first), length_(kStepBatch) {
-    if (end - first == kStepBatch) return;
-    length_ = by_neighbour_count(s.neighbour_count, first, end, lanes, sorted_here_);
-    begin_ = sorted_here_;
-  }
-  const std::uint32_t* begin() const { return begin_; }
-  const std::uint32_t* end() const { return begin_ + length_; }
-
- private:
-  std::uint32_t sorted_here_[kStepBatch + 7];
-  const std::uint32_t* begin_;
-  std::uint32_t length_;
-};
 
 // Lanes<V> (each kernel file) says how a vector holds a group of balls, one
 // per lane: kCount lanes; load(rows, j, x, y, z, w) gathers rows[j[0..]] into
@@ -138,22 +138,14 @@ struct GroupBalls {
 // estimates).
 template <class V>
 [[gnu::always_inline]] inline void neighbour_forces(const StepArrays& s, const ContactModel& m,
-                                                    const std::uint32_t* group, const GroupBalls<V>& i, V& fx, V& fy,
-                                                    V& fz) {
-  constexpr std::uint32_t kCount = Lanes<V>::kCount;
+                                                    const std::uint32_t* block, std::uint32_t blocks,
+                                                    const GroupBalls<V>& i, V& fx, V& fy, V& fz) {
   const V k = V::splat(m.k), neg_damping = V::splat(-m.damping_factor);
   const V tiny = V::splat(1e-12f);  // squared distance floor: coincident centres stay finite
-  // Past its end, a shorter list's row holds the ghost: it touches nothing.
-  const std::uint32_t* row[kCount];
-  std::uint32_t longest = 0;
-  for (std::uint32_t l = 0; l < kCount; ++l) {
-    row[l] = s.neighbours + std::size_t(group[l]) * s.stride;
-    longest = std::max(longest, s.neighbour_count[group[l]]);
-  }
   fx = fy = fz = V::zero();
-  for (std::uint32_t n = 0; n < longest; ++n) {
-    std::uint32_t j[kCount];
-    for (std::uint32_t l = 0; l < kCount; ++l) j[l] = row[l][n];
+  // Past its end, a shorter list's lane holds the ghost: it touches nothing.
+  for (const std::uint32_t* const last = block + blocks * Lanes<V>::kCount; block < last; block += Lanes<V>::kCount) {
+    const std::uint32_t* j = block;
     V dx, dy, dz, rj;
     Lanes<V>::load(s.pos, j, dx, dy, dz, rj);
     dx -= i.x, dy -= i.y, dz -= i.z;
@@ -224,23 +216,27 @@ template <class V>
   fz = fz / i.m;
 }
 
-// Each pass takes the balls of a batch (kStepBatch, kernels.h) in groups of
-// kCount by neighbour count (BatchOrder), one ball per lane: the neighbour
-// sums, then walls, players, kick and drift for the group's balls at once,
-// and the results scattered back to their rows. A padded group repeats a
-// ball: it is computed twice and stored twice, with the same result.
+// Each pass takes a batch's groups (kStepBatch, broadphase.h), one ball per
+// lane: the neighbour sums from the group's blocks, then walls, players, kick
+// and drift for the group's balls at once, and the results scattered back to
+// their rows. A padded group repeats a ball: it is computed twice and stored
+// twice, with the same result.
 template <class V, class PerGroup>
 [[gnu::always_inline]] inline void for_each_group(const StepArrays& s, std::uint32_t begin, std::uint32_t end,
                                                   PerGroup per_group) {
   constexpr std::uint32_t kCount = Lanes<V>::kCount;
-  for (std::uint32_t batch = begin, last_of_batch; batch < end; batch = last_of_batch) {
-    last_of_batch = batch_end(batch, end);
-    const BatchOrder order(s, batch, last_of_batch, kCount);
-    for (const std::uint32_t* group = order.begin(); group < order.end(); group += kCount) {
+  for (std::uint32_t batch = begin; batch < end; batch += kStepBatch) {
+    const std::uint32_t* block = s.neighbours + std::size_t(batch) * s.stride;
+    const std::uint32_t* group = s.batch_order + batch;
+    const std::uint32_t* const groups_end = group + grouped_length(batch_end(batch, end) - batch, kCount);
+    for (; group < groups_end; group += kCount) {
+      std::uint32_t blocks = 0;
+      for (std::uint32_t l = 0; l < kCount; ++l) blocks = std::max(blocks, s.neighbour_count[group[l]]);
       GroupBalls<V> i;
       Lanes<V>::load(s.pos, group, i.x, i.y, i.z, i.r);
       Lanes<V>::load(s.vel_half, group, i.vx, i.vy, i.vz, i.m);
-      per_group(group, i);
+      per_group(group, block, blocks, i);
+      block += std::size_t(blocks) * kCount;
     }
   }
 }
@@ -252,33 +248,37 @@ float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
   const StepArrays s = arrays;
   const ContactModel m = model;
   V max_d2 = V::zero();
-  for_each_group<V>(s, begin, end, [&](const std::uint32_t* group, const GroupBalls<V>& i) {
-    V ax, ay, az;
-    neighbour_forces(s, m, group, i, ax, ay, az);
-    acceleration(s, m, i, ax, ay, az);
-    const V half_dt = V::splat(m.half_dt), dt = V::splat(m.dt);
-    const V vx = mul_add(ax, half_dt, i.vx), vy = mul_add(ay, half_dt, i.vy), vz = mul_add(az, half_dt, i.vz);
-    Lanes<V>::store(vx, vy, vz, i.m, s.vel, group);
-    const V hx = mul_add(ax, half_dt, vx), hy = mul_add(ay, half_dt, vy), hz = mul_add(az, half_dt, vz);
-    Lanes<V>::store(hx, hy, hz, i.m, s.vel_half_next, group);
-    const V px = mul_add(hx, dt, i.x), py = mul_add(hy, dt, i.y), pz = mul_add(hz, dt, i.z);
-    Lanes<V>::store(px, py, pz, i.r, s.pos_next, group);
-    V bx, by, bz, br;
-    Lanes<V>::load(s.pos_at_build, group, bx, by, bz, br);
-    bx -= px, by -= py, bz -= pz;
-    max_d2 = max(max_d2, mul_add(bz, bz, mul_add(by, by, bx * bx)));
-  });
+  for_each_group<V>(
+      s, begin, end,
+      [&](const std::uint32_t* group, const std::uint32_t* block, std::uint32_t blocks, const GroupBalls<V>& i) {
+        V ax, ay, az;
+        neighbour_forces(s, m, block, blocks, i, ax, ay, az);
+        acceleration(s, m, i, ax, ay, az);
+        const V half_dt = V::splat(m.half_dt), dt = V::splat(m.dt);
+        const V vx = mul_add(ax, half_dt, i.vx), vy = mul_add(ay, half_dt, i.vy), vz = mul_add(az, half_dt, i.vz);
+        Lanes<V>::store(vx, vy, vz, i.m, s.vel, group);
+        const V hx = mul_add(ax, half_dt, vx), hy = mul_add(ay, half_dt, vy), hz = mul_add(az, half_dt, vz);
+        Lanes<V>::store(hx, hy, hz, i.m, s.vel_half_next, group);
+        const V px = mul_add(hx, dt, i.x), py = mul_add(hy, dt, i.y), pz = mul_add(hz, dt, i.z);
+        Lanes<V>::store(px, py, pz, i.r, s.pos_next, group);
+        V bx, by, bz, br;
+        Lanes<V>::load(s.pos_at_build, group, bx, by, bz, br);
+        bx -= px, by -= py, bz -= pz;
+        max_d2 = max(max_d2, mul_add(bz, bz, mul_add(by, by, bx * bx)));
+      });
   return Lanes<V>::largest(max_d2);
 }
 
 template <class V>
 void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin, std::uint32_t end) {
-  for_each_group<V>(s, begin, end, [&](const std::uint32_t* group, const GroupBalls<V>& i) {
-    V ax, ay, az;
-    neighbour_forces(s, m, group, i, ax, ay, az);
-    acceleration(s, m, i, ax, ay, az);
-    Lanes<V>::store(ax, ay, az, V::zero(), acc, group);
-  });
+  for_each_group<V>(
+      s, begin, end,
+      [&](const std::uint32_t* group, const std::uint32_t* block, std::uint32_t blocks, const GroupBalls<V>& i) {
+        V ax, ay, az;
+        neighbour_forces(s, m, block, blocks, i, ax, ay, az);
+        acceleration(s, m, i, ax, ay, az);
+        Lanes<V>::store(ax, ay, az, V::zero(), acc, group);
+      });
 }
 
 }  // namespace

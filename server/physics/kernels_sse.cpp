@@ -35,6 +35,6 @@ struct Lanes<F4> {
 
 }  // namespace
 
-const Kernels kSseKernels{"sse", "sse4.1", true, step<F4>, accelerations<F4>, build_lists_and_batch_order};
+const Kernels kSseKernels{"sse", "sse4.1", true, 4, step<F4>, accelerations<F4>, build_lists<4>};
 
 }  // namespace fishtank

@@ -193,9 +193,9 @@ void World::rebuild() {
   id_.swap(id_scratch_);
   set_ghost();  // the swapped-in buffers' tails
 
-  if (list_.stride() == 0) list_.reserve(n_, 32);
+  if (list_.stride() == 0) list_.reserve(n_, 32, kernels_.list_lanes);
   for (;;) {
-    list_.reserve(n_, list_.stride());
+    list_.reserve(n_, list_.stride(), kernels_.list_lanes);
     std::fill(thread_longest_.begin(), thread_longest_.end(), 0u);
     const ListBuild build = list_.build_view(pos_.data(), n_);
     pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int thread) {
@@ -203,7 +203,7 @@ void World::rebuild() {
     });
     std::uint32_t longest = *std::max_element(thread_longest_.begin(), thread_longest_.end());
     if (longest <= list_.stride()) break;
-    list_.reserve(n_, longest + 8);
+    list_.reserve(n_, longest + 8, kernels_.list_lanes);
   }
   needs_rebuild_ = false;
   ++rebuilds_;
@@ -296,15 +296,17 @@ double World::elastic_energy() const {
   if (needs_rebuild_) return 0.0;  // no lists yet: nothing has been stepped
   const TankBounds& t = params_.tank;
   double sum_x2 = 0.0;
-  for (std::uint32_t i = 0; i < n_; ++i) {
+  list_.for_each_list(n_, [&](std::uint32_t i, ListView list) {
     const Float4& p = pos_[i];
-    const std::uint32_t* list = list_.neighbours() + std::size_t(i) * list_.stride();
-    for (std::uint32_t n = 0; n < list_.counts()[i]; ++n) {
+    for (std::uint32_t n = 0; n < list.count; ++n) {
       const Float4& q = pos_[list[n]];
       double dx = p.x - q.x, dy = p.y - q.y, dz = p.z - q.z;
       double overlap = p.w + q.w - std::sqrt(dx * dx + dy * dy + dz * dz);
       if (overlap > 0.0) sum_x2 += 0.5 * overlap * overlap;  // each pair is listed from both sides
     }
+  });
+  for (std::uint32_t i = 0; i < n_; ++i) {
+    const Float4& p = pos_[i];
     for (double overlap : {t.min.x + p.w - p.x, p.x + p.w - t.max.x, t.min.y + p.w - p.y, p.y + p.w - t.max.y,
                            t.min.z + p.w - p.z, p.z + p.w - t.max.z})
       if (overlap > 0.0) sum_x2 += overlap * overlap;
@@ -315,18 +317,20 @@ double World::elastic_energy() const {
 float World::max_overlap_fraction() const {
   float worst = 0.0f;
   const TankBounds& t = params_.tank;
-  for (std::uint32_t i = 0; i < n_; ++i) {
-    const Float4& p = pos_[i];
-    // The neighbour list holds every touching pair (stale only between a spawn and the next step).
-    if (!needs_rebuild_) {
-      const std::uint32_t* list = list_.neighbours() + std::size_t(i) * list_.stride();
-      for (std::uint32_t n = 0; n < list_.counts()[i]; ++n) {
+  // The neighbour list holds every touching pair (stale only between a spawn and the next step).
+  if (!needs_rebuild_) {
+    list_.for_each_list(n_, [&](std::uint32_t i, ListView list) {
+      const Float4& p = pos_[i];
+      for (std::uint32_t n = 0; n < list.count; ++n) {
         const Float4& q = pos_[list[n]];
         float dx = p.x - q.x, dy = p.y - q.y, dz = p.z - q.z;
         float overlap = p.w + q.w - std::sqrt(dx * dx + dy * dy + dz * dz);
         worst = std::max(worst, overlap / std::min(p.w, q.w));
       }
-    }
+    });
+  }
+  for (std::uint32_t i = 0; i < n_; ++i) {
+    const Float4& p = pos_[i];
     float walls = std::max({t.min.x + p.w - p.x, p.x + p.w - t.max.x, t.min.y + p.w - p.y, p.y + p.w - t.max.y,
                             t.min.z + p.w - p.z, p.z + p.w - t.max.z});
     worst = std::max(worst, walls / p.w);

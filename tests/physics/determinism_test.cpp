@@ -3,6 +3,7 @@
 // for 1, 2 and 4 threads (compared through a hash of every position and
 // velocity, as Box2D does).
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cstring>
 #include <numeric>
@@ -59,72 +60,123 @@ TEST_CASE("the AVX2 level's state is bit-identical for 1, 2 and 3 threads", "[ph
 
 namespace {
 
-// One step of n densely packed random balls of every kind (many in contact),
-// by a kernel called on the given consecutive ranges of balls; returns every
-// output value's bits.
-std::vector<std::uint32_t> step_in_ranges(const Kernels& kernels, const std::vector<std::uint32_t>& bounds) {
-  const std::uint32_t n = bounds.back();
-  PhysicsParams params;
-  params.tank.min = {-6.0f, 0.0f, -6.0f};
-  params.tank.max = {6.0f, 12.0f, 6.0f};
-  const ContactModel model = make_contact_model(params);
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<float> at(-5.0f, 5.0f), speed(-1.0f, 1.0f);
-  AlignedVector<Float4> unsorted(n + kGhostSlots, kGhostPos), vel_half(n + kGhostSlots, Float4{0, 0, 0, 1});
-  for (std::uint32_t i = 0; i < n; ++i) {
-    const BallKind& kind = kBallKinds[i % kKindCount];
-    unsorted[i] = {at(rng), 6.0f + at(rng), at(rng), 0.5f * kind.diameter};
-    vel_half[i] = {speed(rng), speed(rng), speed(rng), kind.mass};
-  }
+// n densely packed random balls of every kind (many in contact), in cell
+// order, with their lists as a kernel set builds them.
+struct DenseScene {
+  ContactModel model;
+  AlignedVector<Float4> pos, vel_half;
   NeighbourList list;
-  list.configure(params.tank, params.skin);
-  std::vector<std::uint32_t> order;
-  list.sort(unsorted.data(), n, order);
-  AlignedVector<Float4> pos(unsorted);  // cell order, as the world keeps it
-  for (std::uint32_t k = 0; k < n; ++k) pos[k] = unsorted[order[k]];
-  list.reserve(n, 64);
-  REQUIRE(kernels.build_lists(list.build_view(pos.data(), n), 0, n) <= list.stride());
-  const std::uint32_t listed = std::accumulate(list.counts(), list.counts() + n, 0u);
-  REQUIRE(listed > 4 * n);  // dense: most balls have several neighbours, of different counts
+  std::uint32_t n;
 
-  AlignedVector<Float4> vel(n), pos_next(n), vel_half_next(n);
-  const StepArrays s{pos.data(),
-                     vel_half.data(),
-                     vel.data(),
-                     pos_next.data(),
-                     vel_half_next.data(),
-                     pos.data(),
-                     list.neighbours(),
-                     list.counts(),
-                     list.stride(),
-                     list.batch_order(),
-                     nullptr,
-                     nullptr,
-                     0};
-  for (std::size_t r = 0; r + 1 < bounds.size(); ++r) kernels.step(s, model, bounds[r], bounds[r + 1]);
-  std::vector<std::uint32_t> bits;
-  for (const AlignedVector<Float4>* out : {&vel, &pos_next, &vel_half_next})
-    for (const Float4& f : *out)
-      for (float x : {f.x, f.y, f.z, f.w}) {
-        std::uint32_t b;
-        std::memcpy(&b, &x, sizeof b);
-        bits.push_back(b);
-      }
-  return bits;
+  DenseScene(const Kernels& kernels, std::uint32_t balls) : n(balls) {
+    PhysicsParams params;
+    params.tank.min = {-6.0f, 0.0f, -6.0f};
+    params.tank.max = {6.0f, 12.0f, 6.0f};
+    model = make_contact_model(params);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> at(-5.0f, 5.0f), speed(-1.0f, 1.0f);
+    AlignedVector<Float4> unsorted(n + kGhostSlots, kGhostPos), unsorted_vel(n + kGhostSlots, Float4{0, 0, 0, 1});
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const BallKind& kind = kBallKinds[i % kKindCount];
+      unsorted[i] = {at(rng), 6.0f + at(rng), at(rng), 0.5f * kind.diameter};
+      unsorted_vel[i] = {speed(rng), speed(rng), speed(rng), kind.mass};
+    }
+    list.configure(params.tank, params.skin);
+    std::vector<std::uint32_t> order;
+    list.sort(unsorted.data(), n, order);
+    pos = unsorted;
+    vel_half = unsorted_vel;
+    for (std::uint32_t k = 0; k < n; ++k) pos[k] = unsorted[order[k]], vel_half[k] = unsorted_vel[order[k]];
+    list.reserve(n, 64, kernels.list_lanes);
+    REQUIRE(kernels.build_lists(list.build_view(pos.data(), n), 0, n) <= list.stride());
+    const std::uint32_t listed = std::accumulate(list.counts(), list.counts() + n, 0u);
+    REQUIRE(listed > 4 * n);  // dense: most balls have several neighbours, of different counts
+  }
+
+  // One step by the kernel, called on the given consecutive ranges of balls,
+  // with the lists laid out in `neighbours` and `batch_order`; returns every
+  // output value's bits.
+  std::vector<std::uint32_t> step_bits(const Kernels& kernels, const std::vector<std::uint32_t>& bounds,
+                                       const std::uint32_t* neighbours, const std::uint32_t* batch_order) const {
+    AlignedVector<Float4> vel(n), pos_next(n), vel_half_next(n);
+    const StepArrays s{pos.data(),
+                       vel_half.data(),
+                       vel.data(),
+                       pos_next.data(),
+                       vel_half_next.data(),
+                       pos.data(),
+                       neighbours,
+                       list.counts(),
+                       list.stride(),
+                       batch_order,
+                       nullptr,
+                       nullptr,
+                       0};
+    for (std::size_t r = 0; r + 1 < bounds.size(); ++r) kernels.step(s, model, bounds[r], bounds[r + 1]);
+    std::vector<std::uint32_t> bits;
+    for (const AlignedVector<Float4>* out : {&vel, &pos_next, &vel_half_next})
+      for (const Float4& f : *out)
+        for (float x : {f.x, f.y, f.z, f.w}) {
+          std::uint32_t b;
+          std::memcpy(&b, &x, sizeof b);
+          bits.push_back(b);
+        }
+    return bits;
+  }
+};
+
+// The scene's lists laid out again (broadphase.h) with each batch's balls
+// shuffled before grouping, so that every ball shares its vector with other
+// balls than in the build's grouping by count.
+struct Layout {
+  std::vector<std::uint32_t> neighbours, batch_order;
+};
+
+Layout shuffled_groups(const DenseScene& scene, std::uint32_t lanes) {
+  const std::uint32_t n = scene.n;
+  std::vector<std::vector<std::uint32_t>> lists(n);
+  scene.list.for_each_list(n, [&](std::uint32_t i, ListView l) {
+    for (std::uint32_t k = 0; k < l.count; ++k) lists[i].push_back(l[k]);
+  });
+  Layout out;
+  out.neighbours.assign((std::size_t(n) + lanes - 1) * scene.list.stride(), 0);
+  out.batch_order.assign(std::size_t(n) + lanes - 1, 0);
+  std::mt19937 rng(3);
+  for (std::uint32_t batch = 0; batch < n; batch += kStepBatch) {
+    const std::uint32_t balls = batch_end(batch, n) - batch, grouped = grouped_length(balls, lanes);
+    std::uint32_t* order = out.batch_order.data() + batch;
+    std::iota(order, order + balls, batch);
+    std::shuffle(order, order + balls, rng);
+    for (std::uint32_t k = balls; k < grouped; ++k) order[k] = order[k - 1];
+    std::uint32_t* block = out.neighbours.data() + std::size_t(batch) * scene.list.stride();
+    for (std::uint32_t g = 0; g < grouped; g += lanes) {
+      std::size_t blocks = 0;
+      for (std::uint32_t l = 0; l < lanes; ++l) blocks = std::max(blocks, lists[order[g + l]].size());
+      for (std::size_t b = 0; b < blocks; ++b)
+        for (std::uint32_t l = 0; l < lanes; ++l) {
+          const std::vector<std::uint32_t>& list = lists[order[g + l]];
+          *block++ = b < list.size() ? list[b] : n;  // the ghost past a list's end
+        }
+    }
+  }
+  return out;
 }
 
 }  // namespace
 
 TEST_CASE("a ball's step does not depend on which balls share its vector", "[physics][determinism]") {
-  // Ranges that start at odd balls and cut batches short: each SIMD kernel then
-  // sorts those batches itself and groups other balls in its vectors than
-  // when it steps all 300 at once.
+  // Each SIMD kernel groups balls of similar neighbour counts, one per lane;
+  // the same lists grouped at random, and the step called on chunks of
+  // batches as the worker threads call it, must give every ball the same bits.
   std::vector<const Kernels*> simd{&kSseKernels};
   if (cpu_has_avx2()) simd.push_back(&kAvx2Kernels);
   for (const Kernels* kernels : simd) {
     INFO(kernels->variant);
-    const std::vector<std::uint32_t> whole = step_in_ranges(*kernels, {0, 300});
-    CHECK(step_in_ranges(*kernels, {0, 1, 4, 101, 300}) == whole);
-    CHECK(step_in_ranges(*kernels, {0, 37, 64, 299, 300}) == whole);
+    const DenseScene scene(*kernels, 300);
+    const std::vector<std::uint32_t> built =
+        scene.step_bits(*kernels, {0, 300}, scene.list.neighbours(), scene.list.batch_order());
+    CHECK(scene.step_bits(*kernels, {0, 64, 192, 300}, scene.list.neighbours(), scene.list.batch_order()) == built);
+    const Layout shuffled = shuffled_groups(scene, kernels->list_lanes);
+    CHECK(scene.step_bits(*kernels, {0, 300}, shuffled.neighbours.data(), shuffled.batch_order.data()) == built);
   }
 }

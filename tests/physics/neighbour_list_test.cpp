@@ -35,14 +35,18 @@ Lists build(const Kernels& kernels, const TankBounds& tank, const AlignedVector<
   list.sort(unsorted.data(), n, order);
   AlignedVector<Float4> pos(unsorted);
   for (std::uint32_t k = 0; k < n; ++k) pos[k] = unsorted[order[k]];
-  list.reserve(n, stride);
+  list.reserve(n, stride, kernels.list_lanes);
   Lists out;
   out.longest = kernels.build_lists(list.build_view(pos.data(), n), 0, n);
-  for (std::uint32_t i = 0; i < n; ++i) {
-    out.counts.push_back(list.counts()[i]);
-    const std::uint32_t* l = list.neighbours() + std::size_t(i) * list.stride();
-    out.entries.emplace_back(l, l + std::min(list.counts()[i], list.stride()));
-  }
+  out.counts.assign(list.counts(), list.counts() + n);
+  out.entries.resize(n);
+  std::vector<int> seen(n, 0);
+  list.for_each_list(n, [&](std::uint32_t i, ListView l) {
+    ++seen[i];
+    for (std::uint32_t k = 0; k < l.count; ++k) out.entries[i].push_back(l[k]);
+  });
+  // The layout holds each ball's list exactly once.
+  REQUIRE(std::count(seen.begin(), seen.end(), 1) == std::ptrdiff_t(n));
   return out;
 }
 
