@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "common/float4.h"
@@ -34,17 +35,29 @@ namespace fishtank {
 // balls in groups of `lanes` (in batch_order), each group as many blocks as
 // its longest list, a block holding the next neighbour of each ball of the
 // group, in list order, or the ghost (index n) for a list that has ended.
+// An entry is the neighbour's byte offset in the ball arrays (list_entry),
+// which an address takes with no shift: x86 scales an index by 8 at most.
 // With one lane (the scalar twin, batch order = ball order) that is each
 // ball's list after the previous ball's; with four or eight (the SIMD twins)
 // a block is one vector's neighbours, contiguous, and the batch's groups are
 // balls of similar counts (kernels_simd_ball.h). stride bounds a list's
 // length: it sizes the room, not the layout, so a batch's lists fill one
 // stretch of memory as long as they are, however large the stride.
-constexpr std::uint32_t kStepBatch = 64;
+constexpr std::uint32_t kStepBatch = 128;
 
 // The end of the batch that holds ball `first`, within [.., end).
 inline std::uint32_t batch_end(std::uint32_t first, std::uint32_t end) {
   return std::min(end, (first / kStepBatch + 1) * kStepBatch);
+}
+
+inline std::uint32_t list_entry(std::uint32_t index) { return index * std::uint32_t(sizeof(Float4)); }
+inline std::uint32_t listed_index(std::uint32_t entry) { return entry / std::uint32_t(sizeof(Float4)); }
+
+// The row of an array of balls (positions, velocities) that a list entry names.
+template <class Row>
+inline Row& listed(Row* rows, std::uint32_t entry) {
+  using Byte = std::conditional_t<std::is_const_v<Row>, const char, char>;
+  return *reinterpret_cast<Row*>(reinterpret_cast<Byte*>(rows) + entry);
 }
 
 // Balls in a batch's groups: count rounded up to a multiple of lanes (the
@@ -76,12 +89,12 @@ struct ListBuild {
   std::uint32_t* batch_order;  // out: per batch, its balls in groups (room for lanes - 1 more at the end)
 };
 
-// One ball's stored list: entry k is first[k * lanes].
+// One ball's stored list: neighbour k is listed_index(first[k * lanes]).
 struct ListView {
   const std::uint32_t* first;
   std::uint32_t count;
   std::uint32_t lanes;
-  std::uint32_t operator[](std::uint32_t k) const { return first[std::size_t(k) * lanes]; }
+  std::uint32_t operator[](std::uint32_t k) const { return listed_index(first[std::size_t(k) * lanes]); }
 };
 
 // Ghost slots after the last ball: a SIMD build reads up to three balls past

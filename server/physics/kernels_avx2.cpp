@@ -19,18 +19,20 @@ using simd::F8;
 template <>
 struct Lanes<F8> {
   static constexpr std::uint32_t kCount = 8;
-  // Ball j[l] in lane l of the low half, j[l + 4] in lane l of the high half.
-  static void load(const Float4* rows, const std::uint32_t* j, F8& x, F8& y, F8& z, F8& w) {
-    simd::transpose(F8::load_pair(rows[j[0]], rows[j[4]]), F8::load_pair(rows[j[1]], rows[j[5]]),
-                    F8::load_pair(rows[j[2]], rows[j[6]]), F8::load_pair(rows[j[3]], rows[j[7]]), x, y, z, w);
+  // Ball at[l] in lane l of the low half, at[l + 4] in lane l of the high half.
+  static void load(const Float4* rows, const std::uint32_t* at, F8& x, F8& y, F8& z, F8& w) {
+    simd::transpose(F8::load_pair(listed(rows, at[0]), listed(rows, at[4])),
+                    F8::load_pair(listed(rows, at[1]), listed(rows, at[5])),
+                    F8::load_pair(listed(rows, at[2]), listed(rows, at[6])),
+                    F8::load_pair(listed(rows, at[3]), listed(rows, at[7])), x, y, z, w);
   }
-  static void store(F8 x, F8 y, F8 z, F8 w, Float4* rows, const std::uint32_t* j) {
+  static void store(F8 x, F8 y, F8 z, F8 w, Float4* rows, const std::uint32_t* at) {
     F8 a, b, c, d;
     simd::transpose(x, y, z, w, a, b, c, d);  // the transpose is its own inverse
-    a.store_pair(rows[j[0]], rows[j[4]]);
-    b.store_pair(rows[j[1]], rows[j[5]]);
-    c.store_pair(rows[j[2]], rows[j[6]]);
-    d.store_pair(rows[j[3]], rows[j[7]]);
+    a.store_pair(listed(rows, at[0]), listed(rows, at[4]));
+    b.store_pair(listed(rows, at[1]), listed(rows, at[5]));
+    c.store_pair(listed(rows, at[2]), listed(rows, at[6]));
+    d.store_pair(listed(rows, at[3]), listed(rows, at[7]));
   }
   static float largest(F8 a) { return simd::max_lane(max(a.lo(), a.hi())); }
 };

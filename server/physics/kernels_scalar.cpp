@@ -32,12 +32,12 @@ inline float wall_force_1d(const ContactModel& m, float pos, float vel, float r,
   const Float4 vi = s.vel_half[i];
   float fx = 0.0f, fy = 0.0f, fz = 0.0f;
   for (std::uint32_t n = 0; n < s.neighbour_count[i]; ++n) {
-    const Float4& pj = s.pos[list[n]];
+    const Float4& pj = listed(s.pos, list[n]);
     float dx = pi.x - pj.x, dy = pi.y - pj.y, dz = pi.z - pj.z;
     float d2 = dx * dx + dy * dy + dz * dz;
     float reach = pi.w + pj.w;
     if (d2 >= reach * reach) continue;
-    const Float4& vj = s.vel_half[list[n]];
+    const Float4& vj = listed(s.vel_half, list[n]);
     float dist = std::max(std::sqrt(d2), 1e-6f);
     float inv_dist = 1.0f / dist;
     float nx = dx * inv_dist, ny = dy * inv_dist, nz = dz * inv_dist;
@@ -131,7 +131,7 @@ std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t
         float dx = pi.x - pj.x, dy = pi.y - pj.y, dz = pi.z - pj.z;
         float cutoff = pi.w + pj.w + b.skin;
         if (dx * dx + dy * dy + dz * dz >= cutoff * cutoff || j == i) continue;
-        if (count < b.stride) list[count] = j;
+        if (count < b.stride) list[count] = list_entry(j);
         ++count;
       }
     });

@@ -108,16 +108,16 @@ std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t
         blocks = std::max(blocks, count[l]);
       }
       for (std::uint32_t n = 0; n < blocks; ++n, block += kLanes)
-        for (std::uint32_t l = 0; l < kLanes; ++l) block[l] = n < count[l] ? row[l][n] : b.n;
+        for (std::uint32_t l = 0; l < kLanes; ++l) block[l] = list_entry(n < count[l] ? row[l][n] : b.n);
     }
   }
   return longest;
 }
 
 // Lanes<V> (each kernel file) says how a vector holds a group of balls, one
-// per lane: kCount lanes; load(rows, j, x, y, z, w) gathers rows[j[0..]] into
-// lanes; store(x, y, z, w, rows, j) scatters them back; largest(a) is the
-// largest lane.
+// per lane: kCount lanes; load(rows, at, x, y, z, w) gathers the rows at list
+// entries at[0..] (byte offsets, broadphase.h) into lanes; store(x, y, z, w,
+// rows, at) scatters them back; largest(a) is the largest lane.
 template <class V>
 struct Lanes;
 
@@ -145,16 +145,15 @@ template <class V>
   fx = fy = fz = V::zero();
   // Past its end, a shorter list's lane holds the ghost: it touches nothing.
   for (const std::uint32_t* const last = block + blocks * Lanes<V>::kCount; block < last; block += Lanes<V>::kCount) {
-    const std::uint32_t* j = block;
     V dx, dy, dz, rj;
-    Lanes<V>::load(s.pos, j, dx, dy, dz, rj);
+    Lanes<V>::load(s.pos, block, dx, dy, dz, rj);
     dx -= i.x, dy -= i.y, dz -= i.z;
     const V d2 = mul_add(dz, dz, mul_add(dy, dy, dx * dx));
     const V reach = rj + i.r;
     const auto touching = d2 < reach * reach;
     // Velocities for every block: in a pile 99 % of blocks have a lane in contact.
     V dvx, dvy, dvz, mj;
-    Lanes<V>::load(s.vel_half, j, dvx, dvy, dvz, mj);
+    Lanes<V>::load(s.vel_half, block, dvx, dvy, dvz, mj);
     dvx -= i.vx, dvy -= i.vy, dvz -= i.vz;
     const V neg_inv_dist = simd::neg_rsqrt(max(d2, tiny));
     const V neg_dist = d2 * neg_inv_dist;
@@ -230,12 +229,15 @@ template <class V, class PerGroup>
     const std::uint32_t* group = s.batch_order + batch;
     const std::uint32_t* const groups_end = group + grouped_length(batch_end(batch, end) - batch, kCount);
     for (; group < groups_end; group += kCount) {
-      std::uint32_t blocks = 0;
-      for (std::uint32_t l = 0; l < kCount; ++l) blocks = std::max(blocks, s.neighbour_count[group[l]]);
+      std::uint32_t blocks = 0, at[kCount];
+      for (std::uint32_t l = 0; l < kCount; ++l) {
+        blocks = std::max(blocks, s.neighbour_count[group[l]]);
+        at[l] = list_entry(group[l]);
+      }
       GroupBalls<V> i;
-      Lanes<V>::load(s.pos, group, i.x, i.y, i.z, i.r);
-      Lanes<V>::load(s.vel_half, group, i.vx, i.vy, i.vz, i.m);
-      per_group(group, block, blocks, i);
+      Lanes<V>::load(s.pos, at, i.x, i.y, i.z, i.r);
+      Lanes<V>::load(s.vel_half, at, i.vx, i.vy, i.vz, i.m);
+      per_group(at, block, blocks, i);
       block += std::size_t(blocks) * kCount;
     }
   }
@@ -250,19 +252,19 @@ float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
   V max_d2 = V::zero();
   for_each_group<V>(
       s, begin, end,
-      [&](const std::uint32_t* group, const std::uint32_t* block, std::uint32_t blocks, const GroupBalls<V>& i) {
+      [&](const std::uint32_t* at, const std::uint32_t* block, std::uint32_t blocks, const GroupBalls<V>& i) {
         V ax, ay, az;
         neighbour_forces(s, m, block, blocks, i, ax, ay, az);
         acceleration(s, m, i, ax, ay, az);
         const V half_dt = V::splat(m.half_dt), dt = V::splat(m.dt);
         const V vx = mul_add(ax, half_dt, i.vx), vy = mul_add(ay, half_dt, i.vy), vz = mul_add(az, half_dt, i.vz);
-        Lanes<V>::store(vx, vy, vz, i.m, s.vel, group);
+        Lanes<V>::store(vx, vy, vz, i.m, s.vel, at);
         const V hx = mul_add(ax, half_dt, vx), hy = mul_add(ay, half_dt, vy), hz = mul_add(az, half_dt, vz);
-        Lanes<V>::store(hx, hy, hz, i.m, s.vel_half_next, group);
+        Lanes<V>::store(hx, hy, hz, i.m, s.vel_half_next, at);
         const V px = mul_add(hx, dt, i.x), py = mul_add(hy, dt, i.y), pz = mul_add(hz, dt, i.z);
-        Lanes<V>::store(px, py, pz, i.r, s.pos_next, group);
+        Lanes<V>::store(px, py, pz, i.r, s.pos_next, at);
         V bx, by, bz, br;
-        Lanes<V>::load(s.pos_at_build, group, bx, by, bz, br);
+        Lanes<V>::load(s.pos_at_build, at, bx, by, bz, br);
         bx -= px, by -= py, bz -= pz;
         max_d2 = max(max_d2, mul_add(bz, bz, mul_add(by, by, bx * bx)));
       });
@@ -273,11 +275,11 @@ template <class V>
 void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin, std::uint32_t end) {
   for_each_group<V>(
       s, begin, end,
-      [&](const std::uint32_t* group, const std::uint32_t* block, std::uint32_t blocks, const GroupBalls<V>& i) {
+      [&](const std::uint32_t* at, const std::uint32_t* block, std::uint32_t blocks, const GroupBalls<V>& i) {
         V ax, ay, az;
         neighbour_forces(s, m, block, blocks, i, ax, ay, az);
         acceleration(s, m, i, ax, ay, az);
-        Lanes<V>::store(ax, ay, az, V::zero(), acc, group);
+        Lanes<V>::store(ax, ay, az, V::zero(), acc, at);
       });
 }
 

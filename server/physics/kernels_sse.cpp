@@ -19,16 +19,17 @@ namespace {
 template <>
 struct Lanes<F4> {
   static constexpr std::uint32_t kCount = 4;
-  static void load(const Float4* rows, const std::uint32_t* j, F4& x, F4& y, F4& z, F4& w) {
-    simd::transpose(F4::load(rows[j[0]]), F4::load(rows[j[1]]), F4::load(rows[j[2]]), F4::load(rows[j[3]]), x, y, z, w);
+  static void load(const Float4* rows, const std::uint32_t* at, F4& x, F4& y, F4& z, F4& w) {
+    simd::transpose(F4::load(listed(rows, at[0])), F4::load(listed(rows, at[1])), F4::load(listed(rows, at[2])),
+                    F4::load(listed(rows, at[3])), x, y, z, w);
   }
-  static void store(F4 x, F4 y, F4 z, F4 w, Float4* rows, const std::uint32_t* j) {
+  static void store(F4 x, F4 y, F4 z, F4 w, Float4* rows, const std::uint32_t* at) {
     F4 a, b, c, d;
     simd::transpose(x, y, z, w, a, b, c, d);  // the transpose is its own inverse
-    a.store(rows[j[0]]);
-    b.store(rows[j[1]]);
-    c.store(rows[j[2]]);
-    d.store(rows[j[3]]);
+    a.store(listed(rows, at[0]));
+    b.store(listed(rows, at[1]));
+    c.store(listed(rows, at[2]));
+    d.store(listed(rows, at[3]));
   }
   static float largest(F4 a) { return simd::max_lane(a); }
 };

@@ -52,7 +52,7 @@ TEST_CASE("the AVX2 level's state is bit-identical for 1, 2 and 3 threads", "[ph
   }
   // The AVX2 kernel carries eight balls per vector and sums with fused
   // multiply-adds; three threads give chunks of unequal lengths (chunks start
-  // at multiples of the 64-ball step batch).
+  // at multiples of the step batch, kStepBatch).
   const std::uint64_t one = run(kAvx2Kernels, 1);
   CHECK(run(kAvx2Kernels, 2) == one);
   CHECK(run(kAvx2Kernels, 3) == one);
@@ -155,7 +155,7 @@ Layout shuffled_groups(const DenseScene& scene, std::uint32_t lanes) {
       for (std::size_t b = 0; b < blocks; ++b)
         for (std::uint32_t l = 0; l < lanes; ++l) {
           const std::vector<std::uint32_t>& list = lists[order[g + l]];
-          *block++ = b < list.size() ? list[b] : n;  // the ghost past a list's end
+          *block++ = list_entry(b < list.size() ? list[b] : n);  // the ghost past a list's end
         }
     }
   }
@@ -175,7 +175,8 @@ TEST_CASE("a ball's step does not depend on which balls share its vector", "[phy
     const DenseScene scene(*kernels, 300);
     const std::vector<std::uint32_t> built =
         scene.step_bits(*kernels, {0, 300}, scene.list.neighbours(), scene.list.batch_order());
-    CHECK(scene.step_bits(*kernels, {0, 64, 192, 300}, scene.list.neighbours(), scene.list.batch_order()) == built);
+    CHECK(scene.step_bits(*kernels, {0, kStepBatch, 2 * kStepBatch, 300}, scene.list.neighbours(),
+                          scene.list.batch_order()) == built);
     const Layout shuffled = shuffled_groups(scene, kernels->list_lanes);
     CHECK(scene.step_bits(*kernels, {0, 300}, shuffled.neighbours.data(), shuffled.batch_order.data()) == built);
   }

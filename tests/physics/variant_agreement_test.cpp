@@ -18,9 +18,9 @@ namespace {
 // Largest position difference from the scalar twin after 500 steps (0.4 s) of
 // a settled 1001-ball pile stirred by a player sphere, so nearly every ball
 // has several contacts throughout. Differences then grow chaotically
-// (3.5e-4 at 1000 steps). The count is not a multiple of the 64-ball step
-// batch, so the SIMD kernels also step a last batch cut short, whose groups
-// are padded with a repeated ball.
+// (3.5e-4 at 1000 steps). The count is not a multiple of the step batch
+// (kStepBatch), so the SIMD kernels also step a last batch cut short, whose
+// groups are padded with a repeated ball.
 float short_horizon_difference(const Kernels& kernels) {
   World pile(PhysicsParams{}, kSseKernels, 2, 1);
   pour_and_settle(pile, 1001, 40.0);
