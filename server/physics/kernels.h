@@ -41,6 +41,9 @@ struct StepArrays {
   const Float4* player_pos;          // x, y, z, radius
   const Float4* player_vel;          // vx, vy, vz, 0
   int players;
+  // Whether the arrays outgrow the caches, so that the SIMD kernels ask for
+  // each batch's rows ahead (kernels_simd_ball.h, prefetch_next_batch).
+  bool beyond_cache = false;
 };
 
 struct Kernels {

@@ -209,6 +209,10 @@ void World::rebuild() {
   ++rebuilds_;
 }
 
+// From this many balls the step pass's arrays (about 140 bytes per ball)
+// outgrow the second-level caches of this machine's two cores (1 MB each).
+constexpr std::uint32_t kBeyondCacheBalls = 32768;
+
 StepArrays World::arrays() {
   return StepArrays{pos_.data(),
                     vel_half_.data(),
@@ -222,7 +226,8 @@ StepArrays World::arrays() {
                     list_.batch_order(),
                     player_pos_.data(),
                     player_vel_.data(),
-                    static_cast<int>(player_pos_.size())};
+                    static_cast<int>(player_pos_.size()),
+                    n_ >= kBeyondCacheBalls};
 }
 
 float World::kick_drift(std::uint32_t i, const Float4& a) {
