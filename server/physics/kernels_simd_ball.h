@@ -220,6 +220,8 @@ template <class V>
   fz = fz / i.m;
 }
 
+constexpr std::size_t kCacheLine = 64;
+
 // Asks for the cache line `bytes` past `base`, to read (kWrite false) or to
 // write. A prefetch never faults, so the address may lie past an array's end;
 // it is formed as an integer, not by pointer arithmetic.
@@ -240,7 +242,7 @@ inline void prefetch(const void* base, std::size_t bytes) {
 template <std::uint32_t kCount>
 [[gnu::always_inline]] inline void prefetch_next_batch(const StepArrays& s, std::uint32_t batch, std::uint32_t share) {
   const std::size_t rows = (std::size_t(batch) + kStepBatch + share * kCount) * sizeof(Float4);
-  for (std::size_t line = rows; line < rows + kCount * sizeof(Float4); line += 64) {
+  for (std::size_t line = rows; line < rows + kCount * sizeof(Float4); line += kCacheLine) {
     prefetch<false>(s.pos, line);
     prefetch<false>(s.vel_half, line);
     prefetch<false>(s.pos_at_build, line);
@@ -248,9 +250,9 @@ template <std::uint32_t kCount>
     prefetch<true>(s.pos_next, line);
     prefetch<true>(s.vel_half_next, line);
   }
-  // A group's blocks take about eight entries per lane.
+  // A group's blocks take about eight entries (32 bytes) per lane.
   const std::size_t lists = (std::size_t(batch) + kStepBatch) * s.stride * sizeof(std::uint32_t);
-  for (std::size_t line = share * kCount * 32; line < (share + 1) * kCount * 32; line += 64)
+  for (std::size_t line = share * kCount * 32; line < (share + 1) * kCount * 32; line += kCacheLine)
     prefetch<false>(s.neighbours, lists + line);
 }
 

@@ -5,7 +5,7 @@
 // Against one ball's neighbours four at a time, this needs no sums over lanes,
 // adds each ball's forces in list order as the scalar twin does, and serves
 // four balls per instruction in walls, kick and drift; grouped by neighbour
-// count, its blocks are as full (1.96 blocks of four per ball on the settled
+// count, its blocks are as full (1.92 blocks of four per ball on the settled
 // tank, against 2.21: technical report, section 4). 1/|d| and sqrt(m_eff) come
 // from the reciprocal-square-root estimate plus a Newton step (1e-7 relative)
 // instead of sqrt and divide; the scalar twin computes them exactly, so the
