@@ -55,7 +55,11 @@ void NeighbourList::reserve(std::uint32_t n, std::uint32_t stride, std::uint32_t
   stride_ = std::max(stride, 1u);
   lanes_ = lanes;
   // The last batch's groups may repeat a ball to fill their lanes.
-  neighbours_.resize((std::size_t(n) + lanes - 1) * stride_);
+  const std::size_t room = (std::size_t(n) + lanes - 1) * stride_;
+  if (room > neighbours_room_) {  // a build rewrites the lists: nothing to keep
+    neighbours_.reset(new std::uint32_t[room]);
+    neighbours_room_ = room;
+  }
   counts_.resize(n);
   batch_order_.resize(std::size_t(n) + lanes - 1);
 }
@@ -70,7 +74,7 @@ ListBuild NeighbourList::build_view(const Float4* pos, std::uint32_t n) {
                    nz_,
                    block_,
                    skin_,
-                   neighbours_.data(),
+                   neighbours_.get(),
                    counts_.data(),
                    stride_,
                    batch_order_.data()};

@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <memory>
 #include <type_traits>
 #include <vector>
 
@@ -147,7 +148,7 @@ class NeighbourList {
   void reserve(std::uint32_t n, std::uint32_t stride, std::uint32_t lanes);
 
   std::uint32_t stride() const { return stride_; }
-  const std::uint32_t* neighbours() const { return neighbours_.data(); }
+  const std::uint32_t* neighbours() const { return neighbours_.get(); }
   const std::uint32_t* counts() const { return counts_.data(); }
   const std::uint32_t* batch_order() const { return batch_order_.data(); }
 
@@ -170,7 +171,11 @@ class NeighbourList {
   std::vector<std::uint32_t> scratch_number_;
   std::uint32_t stride_ = 0;
   std::uint32_t lanes_ = 1;
-  std::vector<std::uint32_t> neighbours_;
+  // Room for the lists, left uninitialised: a build writes only what the lists
+  // take (about a quarter of the room at the default stride), and pages never
+  // written are never mapped.
+  std::unique_ptr<std::uint32_t[]> neighbours_;
+  std::size_t neighbours_room_ = 0;
   std::vector<std::uint32_t> counts_;
   std::vector<std::uint32_t> batch_order_;
 };
@@ -178,7 +183,7 @@ class NeighbourList {
 template <class Visit>
 void NeighbourList::for_each_list(std::uint32_t n, Visit visit) const {
   for (std::uint32_t batch = 0; batch < n; batch += kStepBatch) {
-    const std::uint32_t* block = neighbours_.data() + std::size_t(batch) * stride_;
+    const std::uint32_t* block = neighbours_.get() + std::size_t(batch) * stride_;
     const std::uint32_t* group = batch_order_.data() + batch;
     const std::uint32_t* const groups_end = group + grouped_length(batch_end(batch, n) - batch, lanes_);
     for (; group < groups_end; group += lanes_) {
