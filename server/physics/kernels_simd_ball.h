@@ -257,13 +257,14 @@ template <std::uint32_t kCount>
 }
 
 // Each pass takes a batch's groups (kStepBatch, broadphase.h), one ball per
-// lane: the neighbour sums from the group's blocks, then walls, players, kick
-// and drift for the group's balls at once, and the results scattered back to
-// their rows. A padded group repeats a ball: it is computed twice and stored
-// twice, with the same result.
+// lane: the neighbour sums from the group's blocks, walls and players give
+// a = F / m + g for the group's balls at once, and per_group(at, i, ax, ay,
+// az) does the rest (the step: kick and drift) and scatters the results back
+// to their rows at list entries `at`. A padded group repeats a ball: it is
+// computed twice and stored twice, with the same result.
 template <class V, class PerGroup>
-[[gnu::always_inline]] inline void for_each_group(const StepArrays& s, std::uint32_t begin, std::uint32_t end,
-                                                  PerGroup per_group) {
+[[gnu::always_inline]] inline void for_each_group(const StepArrays& s, const ContactModel& m, std::uint32_t begin,
+                                                  std::uint32_t end, PerGroup per_group) {
   constexpr std::uint32_t kCount = Lanes<V>::kCount;
   for (std::uint32_t batch = begin; batch < end; batch += kStepBatch) {
     const std::uint32_t* block = s.neighbours + std::size_t(batch) * s.stride;
@@ -279,7 +280,10 @@ template <class V, class PerGroup>
       GroupBalls<V> i;
       Lanes<V>::load(s.pos, at, i.x, i.y, i.z, i.r);
       Lanes<V>::load(s.vel_half, at, i.vx, i.vy, i.vz, i.m);
-      per_group(at, block, blocks, i);
+      V ax, ay, az;
+      neighbour_forces(s, m, block, blocks, i, ax, ay, az);
+      acceleration(s, m, i, ax, ay, az);
+      per_group(at, i, ax, ay, az);
       block += std::size_t(blocks) * kCount;
     }
   }
@@ -292,37 +296,27 @@ float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
   const StepArrays s = arrays;
   const ContactModel m = model;
   V max_d2 = V::zero();
-  for_each_group<V>(
-      s, begin, end,
-      [&](const std::uint32_t* at, const std::uint32_t* block, std::uint32_t blocks, const GroupBalls<V>& i) {
-        V ax, ay, az;
-        neighbour_forces(s, m, block, blocks, i, ax, ay, az);
-        acceleration(s, m, i, ax, ay, az);
-        const V half_dt = V::splat(m.half_dt), dt = V::splat(m.dt);
-        const V vx = mul_add(ax, half_dt, i.vx), vy = mul_add(ay, half_dt, i.vy), vz = mul_add(az, half_dt, i.vz);
-        Lanes<V>::store(vx, vy, vz, i.m, s.vel, at);
-        const V hx = mul_add(ax, half_dt, vx), hy = mul_add(ay, half_dt, vy), hz = mul_add(az, half_dt, vz);
-        Lanes<V>::store(hx, hy, hz, i.m, s.vel_half_next, at);
-        const V px = mul_add(hx, dt, i.x), py = mul_add(hy, dt, i.y), pz = mul_add(hz, dt, i.z);
-        Lanes<V>::store(px, py, pz, i.r, s.pos_next, at);
-        V bx, by, bz, br;
-        Lanes<V>::load(s.pos_at_build, at, bx, by, bz, br);
-        bx -= px, by -= py, bz -= pz;
-        max_d2 = max(max_d2, mul_add(bz, bz, mul_add(by, by, bx * bx)));
-      });
+  for_each_group<V>(s, m, begin, end, [&](const std::uint32_t* at, const GroupBalls<V>& i, V ax, V ay, V az) {
+    const V half_dt = V::splat(m.half_dt), dt = V::splat(m.dt);
+    const V vx = mul_add(ax, half_dt, i.vx), vy = mul_add(ay, half_dt, i.vy), vz = mul_add(az, half_dt, i.vz);
+    Lanes<V>::store(vx, vy, vz, i.m, s.vel, at);
+    const V hx = mul_add(ax, half_dt, vx), hy = mul_add(ay, half_dt, vy), hz = mul_add(az, half_dt, vz);
+    Lanes<V>::store(hx, hy, hz, i.m, s.vel_half_next, at);
+    const V px = mul_add(hx, dt, i.x), py = mul_add(hy, dt, i.y), pz = mul_add(hz, dt, i.z);
+    Lanes<V>::store(px, py, pz, i.r, s.pos_next, at);
+    V bx, by, bz, br;
+    Lanes<V>::load(s.pos_at_build, at, bx, by, bz, br);
+    bx -= px, by -= py, bz -= pz;
+    max_d2 = max(max_d2, mul_add(bz, bz, mul_add(by, by, bx * bx)));
+  });
   return Lanes<V>::largest(max_d2);
 }
 
 template <class V>
 void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin, std::uint32_t end) {
-  for_each_group<V>(
-      s, begin, end,
-      [&](const std::uint32_t* at, const std::uint32_t* block, std::uint32_t blocks, const GroupBalls<V>& i) {
-        V ax, ay, az;
-        neighbour_forces(s, m, block, blocks, i, ax, ay, az);
-        acceleration(s, m, i, ax, ay, az);
-        Lanes<V>::store(ax, ay, az, V::zero(), acc, at);
-      });
+  for_each_group<V>(s, m, begin, end, [&](const std::uint32_t* at, const GroupBalls<V>&, V ax, V ay, V az) {
+    Lanes<V>::store(ax, ay, az, V::zero(), acc, at);
+  });
 }
 
 }  // namespace
