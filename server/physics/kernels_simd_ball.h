@@ -6,9 +6,11 @@
 // (kernels_sse.cpp), eight in F8 (kernels_avx2.cpp); each file says how to
 // gather and scatter its lanes (Lanes<V>). For its neighbour sums each lane
 // walks its own ball's list, one neighbour per block, so a group costs as
-// many blocks as its longest list: groups are formed of balls with similar
-// neighbour counts (BatchOrder). Walls, player spheres, kick and drift then
-// serve the whole group per instruction too.
+// many blocks as its longest list: the list build forms groups of balls with
+// similar neighbour counts (by_neighbour_count) and lays their lists out
+// block by block (build_lists, and broadphase.h for the layout). Walls,
+// player spheres, kick and drift then serve the whole group per instruction
+// too.
 //
 // Both files include this header and are compiled with different -m flags, so
 // everything here has internal linkage: each gets its own copy in its own
