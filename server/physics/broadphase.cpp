@@ -65,6 +65,7 @@ void NeighbourList::reserve(std::uint32_t n, std::uint32_t stride, std::uint32_t
 }
 
 ListBuild NeighbourList::build_view(const Float4* pos, std::uint32_t n) {
+  listed_balls_ = n;
   return ListBuild{pos,
                    n,
                    cell_start_.data(),

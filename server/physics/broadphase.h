@@ -152,10 +152,10 @@ class NeighbourList {
   const std::uint32_t* counts() const { return counts_.data(); }
   const std::uint32_t* batch_order() const { return batch_order_.data(); }
 
-  // Calls visit(i, ListView) once for each of the n balls of the last build,
-  // batch by batch in the layout's order.
+  // Calls visit(i, ListView) once for each ball of the last build, batch by
+  // batch in the layout's order.
   template <class Visit>
-  void for_each_list(std::uint32_t n, Visit visit) const;
+  void for_each_list(Visit visit) const;
 
  private:
   CellCoord cell_of(const Float4& p) const;
@@ -171,6 +171,7 @@ class NeighbourList {
   std::vector<std::uint32_t> scratch_number_;
   std::uint32_t stride_ = 0;
   std::uint32_t lanes_ = 1;
+  std::uint32_t listed_balls_ = 0;  // n of the last build_view
   // Room for the lists, left uninitialised: a build writes only what the lists
   // take (about a quarter of the room at the default stride), and pages never
   // written are never mapped.
@@ -181,7 +182,8 @@ class NeighbourList {
 };
 
 template <class Visit>
-void NeighbourList::for_each_list(std::uint32_t n, Visit visit) const {
+void NeighbourList::for_each_list(Visit visit) const {
+  const std::uint32_t n = listed_balls_;
   for (std::uint32_t batch = 0; batch < n; batch += kStepBatch) {
     const std::uint32_t* block = neighbours_.get() + std::size_t(batch) * stride_;
     const std::uint32_t* group = batch_order_.data() + batch;

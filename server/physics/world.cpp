@@ -301,7 +301,7 @@ double World::elastic_energy() const {
   if (needs_rebuild_) return 0.0;  // no lists yet: nothing has been stepped
   const TankBounds& t = params_.tank;
   double sum_x2 = 0.0;
-  list_.for_each_list(n_, [&](std::uint32_t i, ListView list) {
+  list_.for_each_list([&](std::uint32_t i, ListView list) {
     const Float4& p = pos_[i];
     for (std::uint32_t n = 0; n < list.count; ++n) {
       const Float4& q = pos_[list[n]];
@@ -324,7 +324,7 @@ float World::max_overlap_fraction() const {
   const TankBounds& t = params_.tank;
   // The neighbour list holds every touching pair (stale only between a spawn and the next step).
   if (!needs_rebuild_) {
-    list_.for_each_list(n_, [&](std::uint32_t i, ListView list) {
+    list_.for_each_list([&](std::uint32_t i, ListView list) {
       const Float4& p = pos_[i];
       for (std::uint32_t n = 0; n < list.count; ++n) {
         const Float4& q = pos_[list[n]];

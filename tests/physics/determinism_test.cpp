@@ -135,7 +135,7 @@ struct Layout {
 Layout shuffled_groups(const DenseScene& scene, std::uint32_t lanes) {
   const std::uint32_t n = scene.n;
   std::vector<std::vector<std::uint32_t>> lists(n);
-  scene.list.for_each_list(n, [&](std::uint32_t i, ListView l) {
+  scene.list.for_each_list([&](std::uint32_t i, ListView l) {
     for (std::uint32_t k = 0; k < l.count; ++k) lists[i].push_back(l[k]);
   });
   Layout out;

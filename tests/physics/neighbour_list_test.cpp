@@ -41,7 +41,7 @@ Lists build(const Kernels& kernels, const TankBounds& tank, const AlignedVector<
   out.counts.assign(list.counts(), list.counts() + n);
   out.entries.resize(n);
   std::vector<int> seen(n, 0);
-  list.for_each_list(n, [&](std::uint32_t i, ListView l) {
+  list.for_each_list([&](std::uint32_t i, ListView l) {
     ++seen[i];
     for (std::uint32_t k = 0; k < l.count; ++k) out.entries[i].push_back(l[k]);
   });
