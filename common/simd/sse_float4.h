@@ -25,6 +25,7 @@ struct F4 {
   static F4 splat(float s) { return {_mm_set1_ps(s)}; }
   static F4 zero() { return {_mm_setzero_ps()}; }
   static F4 load(const Float4& f) { return {_mm_load_ps(&f.x)}; }
+  static F4 loadu(const float* f) { return {_mm_loadu_ps(f)}; }
   void store(Float4& f) const { _mm_store_ps(&f.x, v); }
 };
 
@@ -60,12 +61,6 @@ inline bool any(M4 m) { return _mm_movemask_ps(m.v) != 0; }
 // Lanes where the mask is off become zero.
 inline F4 keep(M4 m, F4 a) { return {_mm_and_ps(m.v, a.v)}; }
 
-// Lane L of a, broadcast to all four lanes.
-template <int L>
-inline F4 broadcast(F4 a) {
-  return {_mm_shuffle_ps(a.v, a.v, _MM_SHUFFLE(L, L, L, L))};
-}
-
 // Rows a,b,c,d (each x,y,z,w) become columns: xs, ys, zs, ws of the four.
 inline void transpose(F4 a, F4 b, F4 c, F4 d, F4& xs, F4& ys, F4& zs, F4& ws) {
   __m128 t0 = _mm_unpacklo_ps(a.v, b.v);  // ax bx ay by
@@ -78,22 +73,15 @@ inline void transpose(F4 a, F4 b, F4 c, F4 d, F4& xs, F4& ys, F4& zs, F4& ws) {
   ws.v = _mm_movehl_ps(t3, t2);
 }
 
-inline M4 operator&(M4 a, M4 b) { return {_mm_and_ps(a.v, b.v)}; }
 inline int bits(M4 m) { return _mm_movemask_ps(m.v); }  // lane L's flag in bit L
 
 // Four 32-bit indices, for building lists.
 struct I4 {
   __m128i v;
-  static I4 splat(std::uint32_t s) { return {_mm_set1_epi32(static_cast<int>(s))}; }
   static I4 iota(std::uint32_t first) {  // first, first + 1, first + 2, first + 3
     return {_mm_add_epi32(_mm_set1_epi32(static_cast<int>(first)), _mm_setr_epi32(0, 1, 2, 3))};
   }
 };
-// Signed compares: indices stay below 2^31.
-inline M4 operator<(I4 a, I4 b) { return {_mm_castsi128_ps(_mm_cmplt_epi32(a.v, b.v))}; }
-inline M4 operator!=(I4 a, I4 b) {
-  return {_mm_castsi128_ps(_mm_xor_si128(_mm_cmpeq_epi32(a.v, b.v), _mm_set1_epi32(-1)))};
-}
 
 // The lanes of a whose bit is set in mask, packed to the front in lane order
 // and stored at out; all 16 bytes are written, whatever the count.

@@ -14,6 +14,7 @@ void NeighbourList::configure(const TankBounds& tank, float skin) {
   ny_ = std::max(1, static_cast<int>(size.y / min_edge));
   nz_ = std::max(1, static_cast<int>(size.z / min_edge));
   inv_edge_ = {nx_ / size.x, ny_ / size.y, nz_ / size.z};
+  edge_ = {size.x / nx_, size.y / ny_, size.z / nz_};
   block_ = std::min(kBlockCells, nx_);
   const int blocks = (nx_ + block_ - 1) / block_;  // the last may be part empty
   cell_start_.assign(std::size_t(blocks) * block_ * ny_ * nz_ + 1, 0);
@@ -66,6 +67,20 @@ void NeighbourList::reserve(std::uint32_t n, std::uint32_t stride, std::uint32_t
 
 ListBuild NeighbourList::build_view(const Float4* pos, std::uint32_t n) {
   listed_balls_ = n;
+  // The SIMD builds test four or eight consecutive candidates with one load
+  // per axis; a copy costs a fraction of a percent of the build.
+  const std::size_t len = n + kGhostSlots;
+  float *x = nullptr, *y = nullptr, *z = nullptr, *r = nullptr;
+  if (lanes_ > 1) {
+    axes_.resize(4 * len);
+    x = axes_.data(), y = x + len, z = y + len, r = z + len;
+    for (std::size_t k = 0; k < len; ++k) {
+      x[k] = pos[k].x;
+      y[k] = pos[k].y;
+      z[k] = pos[k].z;
+      r[k] = pos[k].w;
+    }
+  }
   return ListBuild{pos,
                    n,
                    cell_start_.data(),
@@ -74,7 +89,13 @@ ListBuild NeighbourList::build_view(const Float4* pos, std::uint32_t n) {
                    ny_,
                    nz_,
                    block_,
+                   tank_.min,
+                   edge_,
                    skin_,
+                   x,
+                   y,
+                   z,
+                   r,
                    neighbours_.get(),
                    counts_.data(),
                    stride_,

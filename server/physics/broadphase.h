@@ -20,7 +20,9 @@
 // world checks that every step and rebuilds only then, as LAMMPS does.
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <type_traits>
 #include <vector>
@@ -83,7 +85,9 @@ struct ListBuild {
   const CellCoord* ball_cell;       // per ball, its cell
   int nx, ny, nz;                   // cells per axis
   int block;                        // cells per block in x
+  Vec3 origin, edge;                // the grid's lowest corner, and its cells' size
   float skin;
+  const float *x, *y, *z, *r;  // the same balls axis by axis, with the ghosts (for lanes > 1 only)
   std::uint32_t* neighbours;   // out: the lists, laid out as above
   std::uint32_t* counts;       // out: the true count, which may exceed stride
   std::uint32_t stride;        // the most entries a list may store
@@ -110,22 +114,57 @@ inline std::size_t cell_number(int x, int y, int z, int ny, int nz, int block) {
   return ((std::size_t(x_block) * nz + z) * ny + y) * block + (x - x_block * block);
 }
 
-// Calls visit(j_begin, j_end) for the index ranges (a row of up to three
-// cells, split where it crosses a block edge, for each of nine rows) that
-// hold every ball of ball i's 27 cells.
+// How far ball i is from the faces of its cell on one axis, squared; at the
+// tank's edge, where no cell lies behind a face, infinitely far.
+struct AxisGaps {
+  float below2, above2;
+};
+inline AxisGaps axis_gaps(float pos, float origin, float edge, int c, int cells) {
+  constexpr float kNone = std::numeric_limits<float>::infinity();
+  // A ball beyond the tank is in the border cell, beyond its outer face, so
+  // its gap to the inner face is still the distance to the cells behind it.
+  const float below = pos - (origin + float(c) * edge), above = edge - below;
+  return {c == 0 ? kNone : below * below, c + 1 == cells ? kNone : above * above};
+}
+
+// Calls visit(j_begin, j_end) for index ranges that hold every ball of ball
+// i's 27 cells that lies within its reach, r_i + the largest radius + skin
+// (any ball closer than r_i + r_j + skin): a neighbouring cell is skipped
+// when its nearest point is further than that, so a small ball in the middle
+// of its cell scans a fraction of them. A row's cells x-1..x+1 are one
+// contiguous range, split where the row crosses a block edge; ranges come in
+// cell order, so the lists are the same with or without the cells skipped.
 template <class Visit>
 inline void for_each_neighbour_range(const ListBuild& b, std::uint32_t i, Visit visit) {
   const CellCoord c = b.ball_cell[i];
-  const int x_lo = c.x > 0 ? c.x - 1 : 0, x_hi = c.x + 1 < b.nx ? c.x + 1 : b.nx - 1;
-  // Where the row splits: the first cell of the second block, or past x_hi.
-  const int split = x_lo / b.block != x_hi / b.block ? x_hi / b.block * b.block : x_hi + 1;
-  for (int z = c.z > 0 ? c.z - 1 : 0; z <= c.z + 1 && z < b.nz; ++z) {
-    for (int y = c.y > 0 ? c.y - 1 : 0; y <= c.y + 1 && y < b.ny; ++y) {
-      visit(b.cell_start[cell_number(x_lo, y, z, b.ny, b.nz, b.block)],
-            b.cell_start[cell_number(split - 1, y, z, b.ny, b.nz, b.block) + 1]);
-      if (split <= x_hi)
-        visit(b.cell_start[cell_number(split, y, z, b.ny, b.nz, b.block)],
-              b.cell_start[cell_number(x_hi, y, z, b.ny, b.nz, b.block) + 1]);
+  const Float4 p = b.pos[i];
+  // The margin covers the rounding of the cells' assignment (sort()).
+  const float reach = (p.w + 0.5f * kMaxBallDiameter + b.skin) * 1.001f + 1e-3f;
+  const float reach2 = reach * reach;
+  const AxisGaps gx = axis_gaps(p.x, b.origin.x, b.edge.x, c.x, b.nx);
+  const AxisGaps gy = axis_gaps(p.y, b.origin.y, b.edge.y, c.y, b.ny);
+  const AxisGaps gz = axis_gaps(p.z, b.origin.z, b.edge.z, c.z, b.nz);
+  const float gap_y[3] = {gy.below2, 0.0f, gy.above2}, gap_z[3] = {gz.below2, 0.0f, gz.above2};
+  // The row's middle cell, and the cells left and right of it: in the same
+  // block (one range with it) or in the neighbouring block (their own range).
+  const int x_block = c.x / b.block, x_in_block = c.x - x_block * b.block;
+  const std::ptrdiff_t y_step = b.block, z_step = std::ptrdiff_t(b.ny) * b.block, block_step = z_step * b.nz;
+  const std::uint32_t* middle =
+      b.cell_start + ((std::ptrdiff_t(x_block) * b.nz + c.z) * b.ny + c.y) * b.block + x_in_block;
+  const bool left_joined = x_in_block > 0, right_joined = x_in_block + 1 < b.block;
+  const std::uint32_t* left = left_joined ? middle - 1 : c.x > 0 ? middle - block_step + (b.block - 1) : middle;
+  const std::uint32_t* right = right_joined     ? middle + 1
+                               : c.x + 1 < b.nx ? middle + block_step - (b.block - 1)
+                                                : middle;
+  for (int dz = 0; dz < 3; ++dz) {
+    for (int dy = 0; dy < 3; ++dy) {
+      const float gap_yz = gap_y[dy] + gap_z[dz];
+      if (gap_yz >= reach2) continue;
+      const std::ptrdiff_t row = (dz - 1) * z_step + (dy - 1) * y_step;
+      const bool with_left = gap_yz + gx.below2 < reach2, with_right = gap_yz + gx.above2 < reach2;
+      if (with_left && !left_joined) visit(left[row], left[row + 1]);
+      visit((with_left && left_joined ? left : middle)[row], (with_right && right_joined ? right : middle)[row + 1]);
+      if (with_right && !right_joined) visit(right[row], right[row + 1]);
     }
   }
 }
@@ -164,7 +203,7 @@ class NeighbourList {
   float skin_ = 0.0f;
   int nx_ = 1, ny_ = 1, nz_ = 1;
   int block_ = 1;  // cells per block in x: min(kBlockCells, nx_)
-  Vec3 inv_edge_;
+  Vec3 inv_edge_, edge_;
   std::vector<std::uint32_t> cell_start_;  // per cell number, first sorted index; one extra at the end
   std::vector<CellCoord> sorted_cell_;     // per sorted ball, its cell
   std::vector<CellCoord> scratch_cell_;
@@ -179,6 +218,7 @@ class NeighbourList {
   std::size_t neighbours_room_ = 0;
   std::vector<std::uint32_t> counts_;
   std::vector<std::uint32_t> batch_order_;
+  AlignedVector<float> axes_;  // x, y, z, radius of the sorted balls, axis by axis (ListBuild)
 };
 
 template <class Visit>

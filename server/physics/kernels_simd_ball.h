@@ -32,37 +32,36 @@ using simd::M4;
 
 // Ball i's list into list (at most b.stride entries); returns its true count.
 // Four candidates at a time: a cell range is contiguous in the sorted arrays,
-// so four consecutive balls are tested at once and the indices of those
-// within reach are packed into the list with one byte shuffle, with no branch
-// per candidate (the scalar build mispredicts on most of them).
+// so four consecutive balls are tested at once, with one load per axis from
+// ListBuild's axis arrays, and the indices of those within reach are packed
+// into the list with one byte shuffle, with no branch per candidate (the
+// scalar build mispredicts on most of them).
 inline std::uint32_t list_of(const ListBuild& b, std::uint32_t i, std::uint32_t* list) {
   // Set bits of a 4-bit mask (the SSE4.1 build has no popcnt instruction:
   // __builtin_popcount would be a library call).
   static constexpr std::uint8_t kFoundCount[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
-  const F4 skin = F4::splat(b.skin);
-  const F4 pi = F4::load(b.pos[i]);
-  const F4 two_ri_skin = simd::broadcast<3>(pi) + simd::broadcast<3>(pi) + skin;
-  const simd::I4 self = simd::I4::splat(i);
+  static constexpr std::uint8_t kFirstLanes[5] = {0x0, 0x1, 0x3, 0x7, 0xf};  // the first k lanes' bits
+  const float *const xs = b.x, *const ys = b.y, *const zs = b.z, *const rs = b.r;
+  const std::uint32_t stride = b.stride;
+  const F4 xi = F4::splat(xs[i]), yi = F4::splat(ys[i]), zi = F4::splat(zs[i]), ri_skin = F4::splat(rs[i] + b.skin);
   std::uint32_t count = 0;
   for_each_neighbour_range(b, i, [&](std::uint32_t j_begin, std::uint32_t j_end) {
-    const simd::I4 range_end = simd::I4::splat(j_end);
     for (std::uint32_t j = j_begin; j < j_end; j += 4) {  // may read up to 3 ghosts past the end
-      F4 dx, dy, dz, ri_minus_rj;
-      simd::transpose(pi - F4::load(b.pos[j]), pi - F4::load(b.pos[j + 1]), pi - F4::load(b.pos[j + 2]),
-                      pi - F4::load(b.pos[j + 3]), dx, dy, dz, ri_minus_rj);
-      const F4 cutoff = two_ri_skin - ri_minus_rj;  // ri + rj + skin
-      const simd::I4 index = simd::I4::iota(j);
-      int found = bits((dx * dx + dy * dy + dz * dz < cutoff * cutoff) & (index < range_end) & (index != self));
-      if (found == 0) continue;
-      if (count + 4 > b.stride) {  // nearly full: one by one, counting on so the caller can grow the list
+      const F4 dx = F4::loadu(xs + j) - xi, dy = F4::loadu(ys + j) - yi, dz = F4::loadu(zs + j) - zi;
+      const F4 cutoff = F4::loadu(rs + j) + ri_skin;  // ri + rj + skin
+      // Lanes past the range's end, and ball i itself, are not neighbours.
+      int found = bits(dx * dx + dy * dy + dz * dz < cutoff * cutoff) & kFirstLanes[std::min(j_end - j, 4u)];
+      if (i - j < 4) found &= ~(1 << (i - j));
+      if (count + 4 > stride) {  // nearly full: one by one, counting on so the caller can grow the list
         for (std::uint32_t lane = 0; lane < 4; ++lane, found >>= 1)
           if (found & 1) {
-            if (count < b.stride) list[count] = j + lane;
+            if (count < stride) list[count] = j + lane;
             ++count;
           }
         continue;
       }
-      compress_store(index, found, list + count);
+      // No branch on whether any was found: it would be mispredicted often.
+      compress_store(simd::I4::iota(j), found, list + count);
       count += kFoundCount[found];
     }
   });

@@ -1,5 +1,6 @@
 // Every list-build kernel finds exactly the pairs within r_i + r_j + skin, in
-// the same order, and reports lists that do not fit instead of overrunning.
+// the same order, however many of the neighbouring cells a ball's reach lets
+// it skip, and reports lists that do not fit instead of overrunning.
 
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -18,12 +19,21 @@ struct Lists {
   std::uint32_t longest = 0;
 };
 
-// n random balls of every kind, packed densely enough that many lists are long.
-AlignedVector<Float4> random_balls(const TankBounds& tank, std::uint32_t n) {
+// n random balls of every kind, packed densely enough that many lists are long;
+// every 16th up to `overhang` units past the tank's faces, as balls pushed
+// through a wall are (the grid keeps them in its border cells).
+AlignedVector<Float4> random_balls(const TankBounds& tank, std::uint32_t n, float overhang = 0.0f) {
   std::mt19937 rng(5);
-  std::uniform_real_distribution<float> x(tank.min.x, tank.max.x), y(tank.min.y, tank.max.y), z(tank.min.z, tank.max.z);
+  auto axis = [](float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi); };
+  auto x = axis(tank.min.x, tank.max.x), y = axis(tank.min.y, tank.max.y), z = axis(tank.min.z, tank.max.z);
+  auto far_x = axis(tank.min.x - overhang, tank.max.x + overhang),
+       far_y = axis(tank.min.y - overhang, tank.max.y + overhang),
+       far_z = axis(tank.min.z - overhang, tank.max.z + overhang);
   AlignedVector<Float4> pos(n + kGhostSlots, kGhostPos);
-  for (std::uint32_t i = 0; i < n; ++i) pos[i] = {x(rng), y(rng), z(rng), 0.5f * kBallKinds[i % kKindCount].diameter};
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const float radius = 0.5f * kBallKinds[i % kKindCount].diameter;
+    pos[i] = i % 16 == 0 ? Float4{far_x(rng), far_y(rng), far_z(rng), radius} : Float4{x(rng), y(rng), z(rng), radius};
+  }
   return pos;
 }
 
@@ -56,12 +66,15 @@ TEST_CASE("every list build finds the same neighbours as a brute-force search", 
   // 20 units: 6 cells across, one block; 60 units: 18 cells, a full block of
   // kBlockCells and a part-empty one, so rows split at the block edge.
   const float width = GENERATE(20.0f, 60.0f);
+  // Balls past the walls sit in the border cells but outside them: the
+  // cells a ball's reach skips must be worked out for them too.
+  const float overhang = GENERATE(0.0f, 3.0f);
   TankBounds tank;
   tank.min = {-0.5f * width, 0.0f, -10.0f};
   tank.max = {0.5f * width, 20.0f, 10.0f};
   const std::uint32_t n = static_cast<std::uint32_t>(150 * width);
-  INFO("tank " << width << " units wide, " << n << " balls");
-  const AlignedVector<Float4> balls = random_balls(tank, n);
+  INFO("tank " << width << " units wide, " << n << " balls, some up to " << overhang << " units outside");
+  const AlignedVector<Float4> balls = random_balls(tank, n, overhang);
   const Lists scalar = build(kScalarKernels, tank, balls, n, 96);
   REQUIRE(scalar.longest <= 96);
 
