@@ -65,6 +65,29 @@ void NeighbourList::reserve(std::uint32_t n, std::uint32_t stride, std::uint32_t
   batch_order_.resize(std::size_t(n) + lanes - 1);
 }
 
+bool NeighbourList::misses_contact(std::uint32_t i, const Float4* pos, const Float4* at_build) const {
+  // Relative margins keep the answer on the safe side of float rounding: a
+  // pair counts as touching a little early, and as listed only if it was
+  // clearly inside the build's cutoff.
+  constexpr float kTouchMargin = 1.0f + 1e-5f, kListedMargin = 1.0f - 1e-5f;
+  ListBuild grid{};
+  grid.cell_start = cell_start_.data();
+  grid.nx = nx_, grid.ny = ny_, grid.nz = nz_, grid.block = block_;
+  grid.origin = tank_.min, grid.edge = edge_, grid.skin = skin_;
+  const Float4 p = pos[i], b = at_build[i];
+  bool missing = false;
+  for_each_range_within_reach(grid, cell_of(p), p, [&](std::uint32_t j_begin, std::uint32_t j_end) {
+    for (std::uint32_t j = j_begin; j < j_end && !missing; ++j) {
+      const Float4 q = pos[j], qb = at_build[j];
+      const float dx = p.x - q.x, dy = p.y - q.y, dz = p.z - q.z, touch = p.w + q.w;
+      const float bx = b.x - qb.x, by = b.y - qb.y, bz = b.z - qb.z, cutoff = touch + skin_;
+      missing = j != i && dx * dx + dy * dy + dz * dz < touch * touch * kTouchMargin &&
+                !(bx * bx + by * by + bz * bz < cutoff * cutoff * kListedMargin);
+    }
+  });
+  return missing;
+}
+
 ListBuild NeighbourList::build_view(const Float4* pos, std::uint32_t n) {
   listed_balls_ = n;
   // The SIMD builds test four or eight consecutive candidates with one load

@@ -15,9 +15,12 @@
 //            build in parallel, and lists come out the same for any thread
 //            count.
 //
-// The list stays valid until some ball has moved more than skin / 2 since the
-// build (two balls closing by skin / 2 each could then touch unseen); the
-// world checks that every step and rebuilds only then, as LAMMPS does.
+// The list stays valid while no ball has moved more than skin / 2 since the
+// build (two balls closing by skin / 2 each could then touch unseen), the
+// LAMMPS criterion. Past that the world keeps it as long as the few balls
+// that moved further, up to skin, touch only balls in their lists
+// (misses_contact): in a million-ball scene the fastest balls are a thin
+// tail, and rebuilding the whole list for them halved the run's speed.
 
 #include <algorithm>
 #include <cstddef>
@@ -127,17 +130,16 @@ inline AxisGaps axis_gaps(float pos, float origin, float edge, int c, int cells)
   return {c == 0 ? kNone : below * below, c + 1 == cells ? kNone : above * above};
 }
 
-// Calls visit(j_begin, j_end) for index ranges that hold every ball of ball
-// i's 27 cells that lies within its reach, r_i + the largest radius + skin
-// (any ball closer than r_i + r_j + skin): a neighbouring cell is skipped
-// when its nearest point is further than that, so a small ball in the middle
-// of its cell scans a fraction of them. A row's cells x-1..x+1 are one
-// contiguous range, split where the row crosses a block edge; ranges come in
-// cell order, so the lists are the same with or without the cells skipped.
+// Calls visit(j_begin, j_end) for index ranges that hold every ball of the
+// 27 cells around cell c that lies within reach of a ball p (radius p.w) in
+// it: r + the largest radius + skin, so any ball closer than r + r_j + skin.
+// A neighbouring cell is skipped when its nearest point is further than
+// that, so a small ball in the middle of its cell scans a fraction of them.
+// A row's cells x-1..x+1 are one contiguous range, split where the row
+// crosses a block edge; ranges come in cell order, so the lists are the same
+// with or without the cells skipped.
 template <class Visit>
-inline void for_each_neighbour_range(const ListBuild& b, std::uint32_t i, Visit visit) {
-  const CellCoord c = b.ball_cell[i];
-  const Float4 p = b.pos[i];
+inline void for_each_range_within_reach(const ListBuild& b, CellCoord c, Float4 p, Visit visit) {
   // The margin covers the rounding of the cells' assignment (sort()).
   const float reach = (p.w + 0.5f * kMaxBallDiameter + b.skin) * 1.001f + 1e-3f;
   const float reach2 = reach * reach;
@@ -169,6 +171,12 @@ inline void for_each_neighbour_range(const ListBuild& b, std::uint32_t i, Visit 
   }
 }
 
+// The ranges that hold every candidate for sorted ball i's list.
+template <class Visit>
+inline void for_each_neighbour_range(const ListBuild& b, std::uint32_t i, Visit visit) {
+  for_each_range_within_reach(b, b.ball_cell[i], b.pos[i], visit);
+}
+
 class NeighbourList {
  public:
   // Cells are at least max diameter + skin wide, so any touching pair is in adjacent cells.
@@ -181,6 +189,14 @@ class NeighbourList {
   // Kernels::build_lists). A list longer than stride() is cut short and its
   // count says so: the caller then grows the stride and builds again.
   ListBuild build_view(const Float4* pos, std::uint32_t n);
+
+  // Whether ball i, now at pos[i], touches a ball that its list lacks: one
+  // whose position at the last build (at_build) was beyond the list's reach.
+  // Valid while no ball has moved more than skin since that build (a ball
+  // that touches i now is then still within the cells the build's reach
+  // covers around i); the world checks this for the few balls that moved more
+  // than skin / 2 instead of rebuilding for them (world.cpp, lists_hold()).
+  bool misses_contact(std::uint32_t i, const Float4* pos, const Float4* at_build) const;
 
   // Room for `stride` neighbours of each of n balls, laid out in groups of
   // `lanes` (Kernels::list_lanes of the build that fills them).

@@ -44,6 +44,7 @@ World::World(const PhysicsParams& params, const Kernels& kernels, int threads, s
   max_balls_ = capacity_;
   thread_max_d2_.resize(pool_.threads());
   thread_longest_.resize(pool_.threads());
+  thread_far_.resize(pool_.threads());
   resize(0);
 }
 
@@ -250,6 +251,40 @@ void World::start_from_current_state() {
   needs_initial_forces_ = false;
 }
 
+bool World::lists_hold() {
+  // Two balls that each moved at most skin / 2 since the build cannot have
+  // closed the skin between them unseen. Past that the lists are kept while
+  // every ball that moved further (a few fast ones, far from the rest of the
+  // pile as a rule) touches only balls in its list, checked one by one, up to
+  // the distance skin, which the check's search covers
+  // (NeighbourList::misses_contact). Beyond a few of them a rebuild is cheaper.
+  const float half_skin = 0.5f * params_.skin, skin = params_.skin;
+  if (next_max_d2_ <= half_skin * half_skin) return true;
+  if (!(next_max_d2_ <= skin * skin)) return false;  // NaN too
+  PhaseTimer timer(phase_seconds_.neighbours);
+  const std::uint32_t most_far = n_ / kFarBallsPerCheck + 16;
+  std::fill(thread_far_.begin(), thread_far_.end(), FarBalls{});
+  pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int thread) {
+    FarBalls& far = thread_far_[thread];
+    for (std::uint32_t i = begin; i < end; ++i) {
+      const Float4 p = pos_[i], b = pos_at_build_[i];
+      const float dx = p.x - b.x, dy = p.y - b.y, dz = p.z - b.z;
+      if (!(dx * dx + dy * dy + dz * dz > half_skin * half_skin * kFarMargin)) continue;
+      // Past most_far in one chunk the total is too: the rest need no check.
+      if (++far.count <= most_far && !far.missing)
+        far.missing = list_.misses_contact(i, pos_.data(), pos_at_build_.data());
+    }
+  });
+  std::uint32_t count = 0;
+  for (const FarBalls& far : thread_far_) {
+    if (far.missing) return false;
+    count += far.count;
+  }
+  if (count > most_far) return false;
+  ++lists_kept_far_;
+  return true;
+}
+
 void World::step() {
   if (spawner_.pending() > 0 && steps_ % kSpawnInterval == 0) spawn();
   if (needs_initial_forces_) start_from_current_state();
@@ -258,8 +293,7 @@ void World::step() {
   pos_.swap(pos_next_);
   vel_half_.swap(vel_half_next_);
   move_players();
-  const float half_skin = 0.5f * params_.skin;
-  if (needs_rebuild_ || !(next_max_d2_ <= half_skin * half_skin)) rebuild();  // NaN also forces a rebuild
+  if (needs_rebuild_ || !lists_hold()) rebuild();
 
   PhaseTimer timer(phase_seconds_.step_pass);
   std::fill(thread_max_d2_.begin(), thread_max_d2_.end(), 0.0f);

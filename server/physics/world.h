@@ -7,7 +7,9 @@
 //   spawn round (every kSpawnInterval steps while balls are queued)
 //   swap           the last pass's pos_next, vel_half_next become pos, vel_half
 //   players move   (serial, few)
-//   rebuild?       if a ball moved > skin/2: sort by cell, reorder, new lists
+//   rebuild?       if a ball moved > skin/2 and the lists miss one of its
+//                  contacts (or it moved > skin, or many did): sort by cell,
+//                  reorder, new lists
 //   step pass    ║ parallel over balls (kernels.h): a = F/m + g, v = v_half + a dt/2,
 //                  then the next half kick and drift into pos_next, vel_half_next
 //
@@ -33,7 +35,7 @@ namespace fishtank {
 
 struct PhaseSeconds {
   double spawn = 0.0;
-  double neighbours = 0.0;  // sort, reorder and list build
+  double neighbours = 0.0;  // sort, reorder and list build, and checks that keep the lists
   double step_pass = 0.0;   // forces and integration
 };
 
@@ -83,6 +85,11 @@ class World {
   double time() const { return time_; }
   std::uint64_t steps() const { return steps_; }
   std::uint64_t rebuilds() const { return rebuilds_; }
+  // Steps whose lists were kept after checking the balls that had moved more
+  // than skin / 2 since the build (lists_hold()).
+  std::uint64_t lists_kept_far() const { return lists_kept_far_; }
+  // The lists of the last build, for tests and tools.
+  const NeighbourList& neighbour_list() const { return list_; }
   float dt() const { return model_.dt; }
   const PhysicsParams& params() const { return params_; }
   const ContactModel& model() const { return model_; }
@@ -121,6 +128,8 @@ class World {
  private:
   void spawn();
   void rebuild();
+  // Whether the lists still hold every contact of the next step's positions.
+  bool lists_hold();
   // Placed balls may start in contact: their first half kick needs the real
   // force, so the next step's half-step state is computed anew for every ball.
   void start_from_current_state();
@@ -158,6 +167,18 @@ class World {
 
   std::uint32_t capacity_;
   std::uint32_t max_balls_;
+  // Balls one chunk found further than skin / 2 from where the lists were
+  // built, and whether one of them touches a ball its list lacks.
+  struct FarBalls {
+    std::uint32_t count = 0;
+    bool missing = false;
+  };
+  // Up to n / kFarBallsPerCheck (+ 16) such balls are checked instead of
+  // rebuilding: at that count the checks cost about as much per step as a
+  // rebuild per ball saves.
+  static constexpr std::uint32_t kFarBallsPerCheck = 256;
+  static constexpr float kFarMargin = 1.0f - 1e-5f;  // a ball right at skin / 2 counts as far
+  std::vector<FarBalls> thread_far_;
   std::vector<float> thread_max_d2_;
   std::vector<std::uint32_t> thread_longest_;
   std::vector<std::uint32_t> order_;
@@ -166,6 +187,7 @@ class World {
   double energy_added_ = 0.0;
   std::uint64_t steps_ = 0;
   std::uint64_t rebuilds_ = 0;
+  std::uint64_t lists_kept_far_ = 0;
   PhaseSeconds phase_seconds_;
 };
 

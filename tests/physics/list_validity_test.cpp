@@ -1,0 +1,106 @@
+// The neighbour lists hold every touching pair at every step: the world keeps
+// them past skin / 2 only after checking each ball that moved that far
+// (World::lists_hold), so fast balls flying into a pile must never reach a
+// ball their list lacks.
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <set>
+#include <utility>
+
+#include "tests/physics/scenarios.h"
+
+using namespace fishtank;
+using namespace fishtank::test;
+
+namespace {
+
+// Touching pairs (i < j, sorted indices) at the world's positions, by brute force.
+std::set<std::pair<std::uint32_t, std::uint32_t>> touching_pairs(const World& world) {
+  std::set<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  const Float4* p = world.positions();
+  for (std::uint32_t i = 0; i < world.ball_count(); ++i)
+    for (std::uint32_t j = i + 1; j < world.ball_count(); ++j) {
+      const float dx = p[i].x - p[j].x, dy = p[i].y - p[j].y, dz = p[i].z - p[j].z, reach = p[i].w + p[j].w;
+      if (dx * dx + dy * dy + dz * dz < reach * reach) pairs.insert({i, j});
+    }
+  return pairs;
+}
+
+std::set<std::pair<std::uint32_t, std::uint32_t>> listed_pairs(const World& world) {
+  std::set<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  world.neighbour_list().for_each_list([&](std::uint32_t i, ListView list) {
+    for (std::uint32_t k = 0; k < list.count; ++k) pairs.insert({std::min(i, list[k]), std::max(i, list[k])});
+  });
+  return pairs;
+}
+
+// Steps the world, and after every step requires each touching pair to be in
+// the lists; returns the number of touching pairs seen.
+std::size_t step_checking_lists(World& world, int steps) {
+  std::size_t contacts = 0;
+  for (int s = 0; s < steps; ++s) {
+    world.step();
+    const auto touching = touching_pairs(world);
+    const auto listed = listed_pairs(world);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> missing;
+    std::set_difference(touching.begin(), touching.end(), listed.begin(), listed.end(), std::back_inserter(missing));
+    INFO("step " << s << ": " << missing.size() << " touching pairs missing from the lists");
+    REQUIRE(missing.empty());
+    contacts += touching.size();
+  }
+  return contacts;
+}
+
+}  // namespace
+
+TEST_CASE("the lists hold every touching pair at every step while fast balls fly into a pile",
+          "[physics][broadphase]") {
+  const std::string variant = GENERATE(from_range(variant_names()));
+  INFO(variant);
+  PhysicsParams params;
+  World world(params, kernels_named(variant), 2, 3);
+  // A settled pile...
+  pour_and_settle(world, 400, 30.0);
+  REQUIRE(world.ball_count() == 400);
+  // ...hit by small balls thrown at 20 units/s (the wide scene's fastest move
+  // about that fast), and by the player sweeping through it at full speed.
+  for (int b = 0; b < 12; ++b) {
+    const float side = b % 2 ? 1.0f : -1.0f;
+    world.place_ball(0, {side * 19.0f, 2.0f + 1.5f * b, -10.0f + 1.7f * b}, {-side * 20.0f, -1.0f, 1.0f});
+  }
+  const std::uint32_t player = world.add_player();
+  world.set_player_velocity(player, Vec3{1.0f, -0.3f, 0.5f} * params.player_max_speed);
+
+  const std::uint64_t rebuilds_before = world.rebuilds(), kept_before = world.lists_kept_far();
+  const std::size_t contacts_checked = step_checking_lists(world, 1500);
+  const std::uint64_t rebuilds = world.rebuilds() - rebuilds_before, kept = world.lists_kept_far() - kept_before;
+  INFO("rebuilds " << rebuilds << ", lists kept after checking the far balls " << kept);
+  CHECK(contacts_checked > 1500 * 250);  // a pile, not a gas
+  CHECK(kept > 100);                     // the path under test ran often
+  CHECK(rebuilds > 10);
+}
+
+TEST_CASE("two balls closing head-on from beyond the skin get a rebuild before they touch unlisted",
+          "[physics][broadphase]") {
+  // Each pair starts skin * (1 + extra) apart, beyond each other's lists, and
+  // closes at 2 x 20 units/s: they touch when each has moved (1 + extra) / 2
+  // skins, more than the half skin after which the lists are only kept if
+  // checked, less than the whole skin that forces a rebuild. Only the check of
+  // the far balls can see the contact coming; nothing else moves.
+  const std::string variant = GENERATE(from_range(variant_names()));
+  INFO(variant);
+  const PhysicsParams params = open_space();
+  World world(params, kernels_named(variant), 1, 3);
+  const float speed = 20.0f, extras[] = {0.2f, 0.5f, 0.8f};
+  for (int pair = 0; pair < 3; ++pair) {
+    const float gap = 1.0f + params.skin * (1.0f + extras[pair]);  // centre distance: two radii 0.5 + the skin and more
+    const Vec3 centre{-30.0f + 30.0f * pair, 50.0f, 0.0f};
+    world.place_ball(0, centre - Vec3{0.5f * gap, 0.0f, 0.0f}, {speed, 0.0f, 0.0f});
+    world.place_ball(0, centre + Vec3{0.5f * gap, 0.0f, 0.0f}, {-speed, 0.0f, 0.0f});
+  }
+  const std::size_t contacts = step_checking_lists(world, 60);
+  CHECK(contacts > 0);                // they met...
+  CHECK(world.lists_kept_far() > 0);  // ...after steps with far balls and kept lists
+  CHECK(world.rebuilds() >= 2);       // and a rebuild came before each contact
+}
