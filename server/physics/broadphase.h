@@ -20,7 +20,7 @@
 // LAMMPS criterion. Past that the world keeps it as long as the few balls
 // that moved further, up to skin, touch only balls in their lists
 // (misses_contact): in a million-ball scene the fastest balls are a thin
-// tail, and rebuilding the whole list for them halved the run's speed.
+// tail, and half the rebuilds were for them alone.
 
 #include <algorithm>
 #include <cstddef>

@@ -18,6 +18,7 @@
 //   vel_half_next = vel + a dt/2,  pos_next = pos + vel_half_next dt
 
 #include <cstdint>
+#include <limits>
 
 #include "common/float4.h"
 #include "server/physics/broadphase.h"
@@ -44,6 +45,18 @@ struct StepArrays {
   // Whether the arrays outgrow the caches, so that the SIMD kernels ask for
   // each batch's rows ahead (kernels_simd_ball.h, prefetch_next_batch).
   bool beyond_cache = false;
+  // A ball whose pos_next is further than sqrt(far_d2) from pos_at_build is
+  // "far": the step of chunk [begin, end) lists its far balls, each once, at
+  // far_balls + begin, for the world to check them one by one
+  // (World::lists_hold). The default lists none.
+  float far_d2 = std::numeric_limits<float>::infinity();
+  std::uint32_t* far_balls = nullptr;
+};
+
+// How far the balls of a chunk moved from where the lists were built.
+struct Moved {
+  float max_d2 = 0.0f;    // the largest squared distance of pos_next from pos_at_build
+  std::uint32_t far = 0;  // balls beyond StepArrays::far_d2, listed at far_balls + begin
 };
 
 struct Kernels {
@@ -55,9 +68,9 @@ struct Kernels {
   // kStepBatch and end is one too or the last ball's index + 1, as in every
   // WorkerPool chunk of the world: the lists are laid out per batch.
   //
-  // The step. Returns the largest squared distance of pos_next from
-  // pos_at_build, which tells when the lists must be rebuilt.
-  float (*step)(const StepArrays& s, const ContactModel& m, std::uint32_t begin, std::uint32_t end);
+  // The step. Returns how far the balls moved from where the lists were
+  // built, which tells when they must be rebuilt.
+  Moved (*step)(const StepArrays& s, const ContactModel& m, std::uint32_t begin, std::uint32_t end);
   // a = F(pos, vel_half) / m + g only, into acc: for a state whose forces are
   // not known yet (balls placed in contact). Writes none of s's outputs.
   void (*accelerations)(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin,

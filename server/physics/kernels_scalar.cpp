@@ -82,12 +82,12 @@ inline float wall_force_1d(const ContactModel& m, float pos, float vel, float r,
   return Float4{fx / vi.w, fy / vi.w - m.gravity, fz / vi.w, 0.0f};
 }
 
-float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t begin, std::uint32_t end) {
+Moved step(const StepArrays& arrays, const ContactModel& model, std::uint32_t begin, std::uint32_t end) {
   // Local copies: stores through the output pointers cannot change them, so
   // pointers and constants stay in registers instead of being reloaded per ball.
   const StepArrays s = arrays;
   const ContactModel m = model;
-  float max_d2 = 0.0f;
+  Moved moved;
   // The neighbour sums of a batch, then the rest per ball: one loop doing both
   // keeps the wall and integration values live across the neighbour loop.
   Float4 pair_force[kStepBatch];
@@ -102,10 +102,12 @@ float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
       const Float4 vh = s.vel_half[i];
       const Float4 v{vh.x + a.x * m.half_dt, vh.y + a.y * m.half_dt, vh.z + a.z * m.half_dt, vh.w};
       s.vel[i] = v;
-      max_d2 = std::max(max_d2, kick_drift(m, v, s.pos[i], a, s.pos_at_build[i], s.vel_half_next[i], s.pos_next[i]));
+      const float d2 = kick_drift(m, v, s.pos[i], a, s.pos_at_build[i], s.vel_half_next[i], s.pos_next[i]);
+      moved.max_d2 = std::max(moved.max_d2, d2);
+      if (d2 > s.far_d2) s.far_balls[begin + moved.far++] = i;
     }
   }
-  return max_d2;
+  return moved;
 }
 
 void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin, std::uint32_t end) {

@@ -291,12 +291,15 @@ template <class V, class PerGroup>
 }
 
 template <class V>
-float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t begin, std::uint32_t end) {
+Moved step(const StepArrays& arrays, const ContactModel& model, std::uint32_t begin, std::uint32_t end) {
   // Local copies: stores through the output pointers cannot change them, so
   // pointers and constants stay in registers instead of being reloaded.
   const StepArrays s = arrays;
   const ContactModel m = model;
   V max_d2 = V::zero();
+  const V far_d2 = V::splat(s.far_d2);
+  std::uint32_t* const far_balls = s.far_balls + begin;
+  std::uint32_t far = 0;
   for_each_group<V>(s, m, begin, end, [&](const std::uint32_t* at, const GroupBalls<V>& i, V ax, V ay, V az) {
     const V half_dt = V::splat(m.half_dt), dt = V::splat(m.dt);
     const V vx = mul_add(ax, half_dt, i.vx), vy = mul_add(ay, half_dt, i.vy), vz = mul_add(az, half_dt, i.vz);
@@ -308,9 +311,15 @@ float step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
     V bx, by, bz, br;
     Lanes<V>::load(s.pos_at_build, at, bx, by, bz, br);
     bx -= px, by -= py, bz -= pz;
-    max_d2 = max(max_d2, mul_add(bz, bz, mul_add(by, by, bx * bx)));
+    const V d2 = mul_add(bz, bz, mul_add(by, by, bx * bx));
+    max_d2 = max(max_d2, d2);
+    if (int lanes = simd::bits(d2 > far_d2)) [[unlikely]] {
+      // A padded group repeats its last ball in the lanes after it: list it once.
+      for (std::uint32_t l = 0; l < Lanes<V>::kCount; ++l, lanes >>= 1)
+        if ((lanes & 1) && (l == 0 || at[l] != at[l - 1])) far_balls[far++] = listed_index(at[l]);
+    }
   });
-  return Lanes<V>::largest(max_d2);
+  return Moved{Lanes<V>::largest(max_d2), far};
 }
 
 template <class V>

@@ -42,9 +42,9 @@ World::World(const PhysicsParams& params, const Kernels& kernels, int threads, s
   list_.configure(params.tank, params.skin);
   capacity_ = static_cast<std::uint32_t>(kPackingLimit * params.tank.volume() / mean_ball_volume());
   max_balls_ = capacity_;
-  thread_max_d2_.resize(pool_.threads());
+  thread_moved_.resize(pool_.threads());
+  thread_missing_.resize(pool_.threads());
   thread_longest_.resize(pool_.threads());
-  thread_far_.resize(pool_.threads());
   resize(0);
 }
 
@@ -54,6 +54,7 @@ void World::resize(std::uint32_t n) {
     v->resize(n + kGhostSlots);
   kind_.resize(n);
   id_.resize(n);
+  far_balls_.resize(n);
   set_ghost();
 }
 
@@ -248,39 +249,34 @@ void World::start_from_current_state() {
   });
   next_max_d2_ = 0.0f;
   for (std::uint32_t i = 0; i < n_; ++i) next_max_d2_ = std::max(next_max_d2_, kick_drift(i, acc_[i]));
+  far_listed_ = false;  // this pass lists no far balls: past skin / 2 the lists are rebuilt
   needs_initial_forces_ = false;
 }
 
 bool World::lists_hold() {
   // Two balls that each moved at most skin / 2 since the build cannot have
   // closed the skin between them unseen. Past that the lists are kept while
-  // every ball that moved further (a few fast ones, far from the rest of the
-  // pile as a rule) touches only balls in its list, checked one by one, up to
-  // the distance skin, which the check's search covers
-  // (NeighbourList::misses_contact). Beyond a few of them a rebuild is cheaper.
+  // every ball that moved further (a few fast ones, the step pass lists them)
+  // touches only balls in its list, checked one by one, up to the distance
+  // skin, which the check's search covers (NeighbourList::misses_contact).
+  // Beyond a few such balls a rebuild is cheaper.
   const float half_skin = 0.5f * params_.skin, skin = params_.skin;
   if (next_max_d2_ <= half_skin * half_skin) return true;
-  if (!(next_max_d2_ <= skin * skin)) return false;  // NaN too
-  PhaseTimer timer(phase_seconds_.neighbours);
-  const std::uint32_t most_far = n_ / kFarBallsPerCheck + 16;
-  std::fill(thread_far_.begin(), thread_far_.end(), FarBalls{});
-  pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int thread) {
-    FarBalls& far = thread_far_[thread];
-    for (std::uint32_t i = begin; i < end; ++i) {
-      const Float4 p = pos_[i], b = pos_at_build_[i];
-      const float dx = p.x - b.x, dy = p.y - b.y, dz = p.z - b.z;
-      if (!(dx * dx + dy * dy + dz * dz > half_skin * half_skin * kFarMargin)) continue;
-      // Past most_far in one chunk the total is too: the rest need no check.
-      if (++far.count <= most_far && !far.missing)
-        far.missing = list_.misses_contact(i, pos_.data(), pos_at_build_.data());
-    }
-  });
-  std::uint32_t count = 0;
-  for (const FarBalls& far : thread_far_) {
-    if (far.missing) return false;
-    count += far.count;
+  if (!(next_max_d2_ <= skin * skin) || !far_listed_) return false;  // NaN too
+  // Each chunk listed its far balls from its begin: gather them to the front.
+  std::uint32_t far = 0;
+  for (const ChunkMoved& chunk : thread_moved_) {
+    std::copy_n(far_balls_.begin() + chunk.begin, chunk.moved.far, far_balls_.begin() + far);
+    far += chunk.moved.far;
   }
-  if (count > most_far) return false;
+  if (far > n_ / kFarBallsPerCheck + 16) return false;
+  PhaseTimer timer(phase_seconds_.neighbours);
+  std::fill(thread_missing_.begin(), thread_missing_.end(), 0);
+  pool_.run(far, [&](std::uint32_t begin, std::uint32_t end, int thread) {
+    for (std::uint32_t k = begin; k < end && !thread_missing_[thread]; ++k)
+      thread_missing_[thread] = list_.misses_contact(far_balls_[k], pos_.data(), pos_at_build_.data());
+  });
+  if (std::find(thread_missing_.begin(), thread_missing_.end(), 1) != thread_missing_.end()) return false;
   ++lists_kept_far_;
   return true;
 }
@@ -296,12 +292,16 @@ void World::step() {
   if (needs_rebuild_ || !lists_hold()) rebuild();
 
   PhaseTimer timer(phase_seconds_.step_pass);
-  std::fill(thread_max_d2_.begin(), thread_max_d2_.end(), 0.0f);
+  std::fill(thread_moved_.begin(), thread_moved_.end(), ChunkMoved{});
   StepArrays s = arrays();
+  s.far_d2 = 0.25f * params_.skin * params_.skin * kFarMargin;
+  s.far_balls = far_balls_.data();
   pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int thread) {
-    thread_max_d2_[thread] = kernels_.step(s, model_, begin, end);
+    thread_moved_[thread] = {begin, kernels_.step(s, model_, begin, end)};
   });
-  next_max_d2_ = *std::max_element(thread_max_d2_.begin(), thread_max_d2_.end());
+  next_max_d2_ = 0.0f;
+  for (const ChunkMoved& chunk : thread_moved_) next_max_d2_ = std::max(next_max_d2_, chunk.moved.max_d2);
+  far_listed_ = true;
   time_ += model_.dt;
   ++steps_;
 }

@@ -167,19 +167,20 @@ class World {
 
   std::uint32_t capacity_;
   std::uint32_t max_balls_;
-  // Balls one chunk found further than skin / 2 from where the lists were
-  // built, and whether one of them touches a ball its list lacks.
-  struct FarBalls {
-    std::uint32_t count = 0;
-    bool missing = false;
-  };
-  // Up to n / kFarBallsPerCheck (+ 16) such balls are checked instead of
-  // rebuilding: at that count the checks cost about as much per step as a
-  // rebuild per ball saves.
+  // Up to n / kFarBallsPerCheck (+ 16) balls further than skin / 2 from
+  // where the lists were built are checked instead of rebuilding: at that
+  // count the checks cost about as much per step as a rebuild per ball saves.
   static constexpr std::uint32_t kFarBallsPerCheck = 256;
   static constexpr float kFarMargin = 1.0f - 1e-5f;  // a ball right at skin / 2 counts as far
-  std::vector<FarBalls> thread_far_;
-  std::vector<float> thread_max_d2_;
+  // What each thread's chunk of the last step pass reported.
+  struct ChunkMoved {
+    std::uint32_t begin = 0;
+    Moved moved;
+  };
+  std::vector<ChunkMoved> thread_moved_;
+  std::vector<char> thread_missing_;      // per thread: a far ball misses a contact
+  std::vector<std::uint32_t> far_balls_;  // per chunk, from its begin: its far balls
+  bool far_listed_ = false;               // whether the last pass listed them
   std::vector<std::uint32_t> thread_longest_;
   std::vector<std::uint32_t> order_;
   std::vector<NewBall> placed_;

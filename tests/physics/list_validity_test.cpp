@@ -84,20 +84,22 @@ TEST_CASE("the lists hold every touching pair at every step while fast balls fly
 TEST_CASE("two balls closing head-on from beyond the skin get a rebuild before they touch unlisted",
           "[physics][broadphase]") {
   // Each pair starts skin * (1 + extra) apart, beyond each other's lists, and
-  // closes at 2 x 20 units/s: they touch when each has moved (1 + extra) / 2
-  // skins, more than the half skin after which the lists are only kept if
-  // checked, less than the whole skin that forces a rebuild. Only the check of
-  // the far balls can see the contact coming; nothing else moves.
+  // closes at 20 + 20 or 20 + 8 units/s: they touch when the faster has moved
+  // more than the half skin after which the lists are only kept if checked,
+  // and less than the whole skin that forces a rebuild (with 20 + 8 the
+  // slower ball stays under the half skin: only the faster one is checked).
+  // Only the check of the far balls can see the contact coming; nothing else
+  // moves.
   const std::string variant = GENERATE(from_range(variant_names()));
   INFO(variant);
   const PhysicsParams params = open_space();
   World world(params, kernels_named(variant), 1, 3);
-  const float speed = 20.0f, extras[] = {0.2f, 0.5f, 0.8f};
-  for (int pair = 0; pair < 3; ++pair) {
-    const float gap = 1.0f + params.skin * (1.0f + extras[pair]);  // centre distance: two radii 0.5 + the skin and more
-    const Vec3 centre{-30.0f + 30.0f * pair, 50.0f, 0.0f};
-    world.place_ball(0, centre - Vec3{0.5f * gap, 0.0f, 0.0f}, {speed, 0.0f, 0.0f});
-    world.place_ball(0, centre + Vec3{0.5f * gap, 0.0f, 0.0f}, {-speed, 0.0f, 0.0f});
+  const float extras[] = {0.1f, 0.2f, 0.3f}, slower[] = {20.0f, 8.0f};
+  for (int pair = 0; pair < 6; ++pair) {
+    const float gap = 1.0f + params.skin * (1.0f + extras[pair % 3]);  // centres: two radii 0.5, the skin and more
+    const Vec3 centre{-40.0f + 16.0f * pair, 50.0f, 0.0f};
+    world.place_ball(0, centre - Vec3{0.5f * gap, 0.0f, 0.0f}, {20.0f, 0.0f, 0.0f});
+    world.place_ball(0, centre + Vec3{0.5f * gap, 0.0f, 0.0f}, {-slower[pair / 3], 0.0f, 0.0f});
   }
   const std::size_t contacts = step_checking_lists(world, 60);
   CHECK(contacts > 0);                // they met...
