@@ -168,8 +168,10 @@ class World {
   std::uint32_t capacity_;
   std::uint32_t max_balls_;
   // Up to n / kFarBallsPerCheck (+ 16) balls further than skin / 2 from
-  // where the lists were built are checked instead of rebuilding: at that
-  // count the checks cost about as much per step as a rebuild per ball saves.
+  // where the lists were built are checked instead of rebuilding. A check
+  // scans about the candidates of one ball's list build, so even at that
+  // count the checks of the (at most ten or so) steps before a ball reaches
+  // the whole skin cost a few percent of the rebuild they put off.
   static constexpr std::uint32_t kFarBallsPerCheck = 256;
   static constexpr float kFarMargin = 1.0f - 1e-5f;  // a ball right at skin / 2 counts as far
   // What each thread's chunk of the last step pass reported.
