@@ -18,7 +18,7 @@ double peak_rss_mib() {
 
 nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleReport& settle) {
   const PhaseSeconds before = world.phase_seconds();
-  const std::uint64_t rebuilds_before = world.rebuilds();
+  const std::uint64_t rebuilds_before = world.rebuilds(), kept_before = world.lists_kept_far();
   // A shared machine's noise comes in bursts: timing several windows and
   // reporting the median keeps one burst from deciding the figure.
   const std::uint32_t windows = static_cast<std::uint32_t>(std::clamp<std::uint64_t>(spec.windows, 1, spec.steps));
@@ -64,6 +64,8 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   j["tank"] = {{"min", {tank.min.x, tank.min.y, tank.min.z}}, {"max", {tank.max.x, tank.max.y, tank.max.z}}};
   j["mean_neighbours"] = world.mean_neighbours();
   j["rebuilds"] = world.rebuilds() - rebuilds_before;
+  // Steps that kept the lists after checking the balls that moved past skin/2.
+  j["lists_kept_after_check"] = world.lists_kept_far() - kept_before;
   j["kinetic_energy_per_ball"] = world.ball_count() ? world.kinetic_energy() / world.ball_count() : 0.0;
   j["settle"] = {{"settled", settle.settled},
                  {"sim_seconds", settle.sim_seconds},

@@ -52,7 +52,7 @@ const std::vector<fishtank::BallView>& settled_tank() {
 // rebuilt while it ran and what share of the time that took (a rebuild costs
 // several steps, and how often one is due depends on the scene).
 void time_steps(benchmark::State& state, World& world) {
-  const std::uint64_t rebuilds_before = world.rebuilds();
+  const std::uint64_t rebuilds_before = world.rebuilds(), kept_before = world.lists_kept_far();
   const fishtank::PhaseSeconds phases_before = world.phase_seconds();
   for (auto _ : state) world.step();
   state.counters["ball_steps_per_s"] =
@@ -60,6 +60,7 @@ void time_steps(benchmark::State& state, World& world) {
   const fishtank::PhaseSeconds& phases = world.phase_seconds();
   const double rebuild_seconds = phases.neighbours - phases_before.neighbours;
   state.counters["rebuilds_per_kstep"] = 1000.0 * double(world.rebuilds() - rebuilds_before) / state.iterations();
+  state.counters["kept_per_kstep"] = 1000.0 * double(world.lists_kept_far() - kept_before) / state.iterations();
   state.counters["rebuild_share"] = rebuild_seconds / (rebuild_seconds + phases.step_pass - phases_before.step_pass);
 }
 
