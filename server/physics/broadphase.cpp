@@ -65,15 +65,20 @@ void NeighbourList::reserve(std::uint32_t n, std::uint32_t stride, std::uint32_t
   batch_order_.resize(std::size_t(n) + lanes - 1);
 }
 
+ListBuild NeighbourList::grid_view() const {
+  ListBuild grid{};
+  grid.cell_start = cell_start_.data();
+  grid.nx = nx_, grid.ny = ny_, grid.nz = nz_, grid.block = block_;
+  grid.origin = tank_.min, grid.edge = edge_, grid.skin = skin_;
+  return grid;
+}
+
 bool NeighbourList::misses_contact(std::uint32_t i, const Float4* pos, const Float4* at_build) const {
   // Relative margins keep the answer on the safe side of float rounding: a
   // pair counts as touching a little early, and as listed only if it was
   // clearly inside the build's cutoff.
   constexpr float kTouchMargin = 1.0f + 1e-5f, kListedMargin = 1.0f - 1e-5f;
-  ListBuild grid{};
-  grid.cell_start = cell_start_.data();
-  grid.nx = nx_, grid.ny = ny_, grid.nz = nz_, grid.block = block_;
-  grid.origin = tank_.min, grid.edge = edge_, grid.skin = skin_;
+  const ListBuild grid = grid_view();
   const Float4 p = pos[i], b = at_build[i];
   bool missing = false;
   for_each_range_within_reach(grid, cell_of(p), p, [&](std::uint32_t j_begin, std::uint32_t j_end) {
@@ -104,25 +109,12 @@ ListBuild NeighbourList::build_view(const Float4* pos, std::uint32_t n) {
       r[k] = pos[k].w;
     }
   }
-  return ListBuild{pos,
-                   n,
-                   cell_start_.data(),
-                   sorted_cell_.data(),
-                   nx_,
-                   ny_,
-                   nz_,
-                   block_,
-                   tank_.min,
-                   edge_,
-                   skin_,
-                   x,
-                   y,
-                   z,
-                   r,
-                   neighbours_.get(),
-                   counts_.data(),
-                   stride_,
-                   batch_order_.data()};
+  ListBuild b = grid_view();
+  b.pos = pos, b.n = n, b.ball_cell = sorted_cell_.data();
+  b.x = x, b.y = y, b.z = z, b.r = r;
+  b.neighbours = neighbours_.get(), b.counts = counts_.data(), b.stride = stride_;
+  b.batch_order = batch_order_.data();
+  return b;
 }
 
 }  // namespace fishtank

@@ -214,6 +214,8 @@ class NeighbourList {
 
  private:
   CellCoord cell_of(const Float4& p) const;
+  // A ListBuild with only the grid filled in: what for_each_range_within_reach reads.
+  ListBuild grid_view() const;
 
   TankBounds tank_;
   float skin_ = 0.0f;

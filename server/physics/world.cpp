@@ -260,8 +260,8 @@ bool World::lists_hold() {
   // touches only balls in its list, checked one by one, up to the distance
   // skin, which the check's search covers (NeighbourList::misses_contact).
   // Beyond a few such balls a rebuild is cheaper.
-  const float half_skin = 0.5f * params_.skin, skin = params_.skin;
-  if (next_max_d2_ <= half_skin * half_skin) return true;
+  const float skin = params_.skin;
+  if (next_max_d2_ <= half_skin_d2()) return true;
   if (!(next_max_d2_ <= skin * skin) || !far_listed_) return false;  // NaN too
   // Each chunk listed its far balls from its begin: gather them to the front.
   std::uint32_t far = 0;
@@ -294,7 +294,7 @@ void World::step() {
   PhaseTimer timer(phase_seconds_.step_pass);
   std::fill(thread_moved_.begin(), thread_moved_.end(), ChunkMoved{});
   StepArrays s = arrays();
-  s.far_d2 = 0.25f * params_.skin * params_.skin * kFarMargin;
+  s.far_d2 = half_skin_d2() * kFarMargin;  // every ball lists_hold() will count as far, and a hair more
   s.far_balls = far_balls_.data();
   pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int thread) {
     thread_moved_[thread] = {begin, kernels_.step(s, model_, begin, end)};

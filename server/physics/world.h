@@ -130,6 +130,7 @@ class World {
   void rebuild();
   // Whether the lists still hold every contact of the next step's positions.
   bool lists_hold();
+  float half_skin_d2() const { return 0.25f * params_.skin * params_.skin; }  // (skin / 2)^2
   // Placed balls may start in contact: their first half kick needs the real
   // force, so the next step's half-step state is computed anew for every ball.
   void start_from_current_state();
