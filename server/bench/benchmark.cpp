@@ -49,6 +49,7 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   j["variant"] = world.kernels().variant;
   j["simd"] = world.kernels().simd;
   j["threads"] = world.threads();
+  j["thread_shares"] = world.thread_shares();  // the split the last timed step measured its way to
   j["balls"] = world.ball_count();
   j["steps"] = spec.steps;
   j["seconds"] = seconds;

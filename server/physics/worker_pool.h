@@ -5,17 +5,27 @@
 //        │ does chunk 0                                   each does chunk t
 //        └──────── waits until `pending` reaches 0 ◄─────────┘
 //
-// Work is split statically into T contiguous chunks, so each thread streams
-// through its own part of the arrays and results never depend on timing.
-// Chunks start at multiples of a granule, so every pass over the same count
-// puts each granule-sized block of items on one thread, whatever the number
-// of threads (the SIMD kernels keep per-block data from one pass to the next). A
+// Work is split into T contiguous chunks, so each thread streams through its
+// own part of the arrays. Chunks start at multiples of a granule, so every
+// pass over the same count puts each granule-sized block of items on one
+// thread, whatever the number of threads (the SIMD kernels keep per-block
+// data from one pass to the next).
+//
+// The split follows the threads' speeds. Cores of a virtual machine are not
+// equal: on this project's 2-core machine one of them ran 30 % slower than
+// the other for minutes at a time (a neighbour on the host), and with equal
+// chunks the fast thread then waits for the slow one at the end of every
+// pass. run_and_balance() times each chunk and moves every later split
+// towards chunks that take equal time (smoothed, and only for a clear
+// imbalance, so that noise does not shuffle blocks between cores: a block
+// that changes thread costs its cache lines a trip between the cores). A
 // phase lasts tens of microseconds in benchmark mode, so workers spin briefly
 // before sleeping on a condition variable: a wake-up from spinning costs well
 // under a microsecond, one from sleep several. With one thread, run() is a
 // plain call with no synchronisation at all, and so is a phase too small to
 // be worth splitting (under ~1000 items per thread). Results never depend on
-// the split: each item is computed by exactly one thread, the same way.
+// the split, so neither on timing: each item is computed by exactly one
+// thread, the same way.
 
 #include <atomic>
 #include <boost/thread/condition_variable.hpp>
@@ -41,7 +51,14 @@ class WorkerPool {
   // Passes use at most this many threads (1..threads()); the others stay idle.
   void set_active_limit(int limit);
   int active_limit() const { return active_limit_; }
+  // Runs phase on `count` items, one chunk per thread, split by the speeds
+  // measured so far (equal chunks until a run has measured them).
   void run(std::uint32_t count, const Phase& phase);
+  // The same, timing each thread's chunk to adapt later splits: for the pass
+  // that takes most of the time, whose chunks' speeds the split should match.
+  void run_and_balance(std::uint32_t count, const Phase& phase);
+  // Each thread's fraction of the items in a run on `active` threads.
+  std::vector<double> shares(int active) const;
   // Wakes sleeping workers now so that they are polling, not asleep, when a
   // run() comes within the next millisecond: a paced caller pays the wake-up
   // while it waits for its next batch instead of inside the batch.
@@ -51,16 +68,27 @@ class WorkerPool {
   static int hardware_threads();
 
  private:
+  // One chunk's duration, on its own cache line: each thread writes its own.
+  struct alignas(64) ChunkTime {
+    double seconds = 0.0;
+  };
+
   void worker_loop(int thread);
   void run_chunk(int thread);
+  void run(std::uint32_t count, const Phase& phase, bool timed);
+  void split(std::uint32_t count);
+  void balance();
 
   int thread_count_;
   std::uint32_t granule_;
+  int active_limit_;
   std::vector<boost::thread> workers_;
   const Phase* phase_ = nullptr;
-  std::uint32_t count_ = 0;
   int active_ = 1;  // threads given a chunk in the current phase
-  int active_limit_;
+  bool timed_ = false;
+  std::vector<std::uint32_t> chunk_start_;  // the current phase's chunks: [start[t], start[t + 1])
+  std::vector<ChunkTime> chunk_time_;
+  std::vector<double> speed_;  // per thread, relative: the split gives each a share in proportion
   std::atomic<std::uint64_t> generation_{0};
   std::atomic<std::uint64_t> wake_calls_{0};
   std::atomic<int> pending_{0};

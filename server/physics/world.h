@@ -98,6 +98,9 @@ class World {
   // Steps use at most this many of the threads (results do not depend on it).
   void set_thread_limit(int limit) { pool_.set_active_limit(limit); }
   int thread_limit() const { return pool_.active_limit(); }
+  // Each thread's fraction of the balls, as the worker pool splits them now
+  // by the threads' measured speeds (WorkerPool::run_and_balance).
+  std::vector<double> thread_shares() const { return pool_.shares(pool_.active_limit()); }
   const PhaseSeconds& phase_seconds() const { return phase_seconds_; }
   double mean_neighbours() const;
 
