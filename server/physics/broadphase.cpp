@@ -63,6 +63,7 @@ void NeighbourList::reserve(std::uint32_t n, std::uint32_t stride, std::uint32_t
   }
   counts_.resize(n);
   batch_order_.resize(std::size_t(n) + lanes - 1);
+  reach_.resize((std::size_t(n) + kStepBatch - 1) / kStepBatch);
 }
 
 ListBuild NeighbourList::grid_view() const {
@@ -114,6 +115,7 @@ ListBuild NeighbourList::build_view(const Float4* pos, std::uint32_t n) {
   b.x = x, b.y = y, b.z = z, b.r = r;
   b.neighbours = neighbours_.get(), b.counts = counts_.data(), b.stride = stride_;
   b.batch_order = batch_order_.data();
+  b.reach = reach_.data();
   return b;
 }
 

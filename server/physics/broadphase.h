@@ -72,6 +72,17 @@ inline std::uint32_t grouped_length(std::uint32_t count, std::uint32_t lanes) {
   return (count + lanes - 1) / lanes * lanes;
 }
 
+// The balls a batch's lists name lie in [lowest, highest] (lowest > highest
+// when they name none). Batches near a chunk's edge name balls of the
+// neighbouring chunk: the world asks for those rows ahead (World::step).
+struct BatchReach {
+  std::uint32_t lowest = std::numeric_limits<std::uint32_t>::max(), highest = 0;
+  void add(std::uint32_t j) {
+    lowest = std::min(lowest, j);
+    highest = std::max(highest, j);
+  }
+};
+
 // What a list build reads and writes: the cell-sorted balls and the grid, and
 // the lists to fill. The build itself is a kernel (kernels.h), scalar or SIMD.
 struct CellCoord {
@@ -95,6 +106,7 @@ struct ListBuild {
   std::uint32_t* counts;       // out: the true count, which may exceed stride
   std::uint32_t stride;        // the most entries a list may store
   std::uint32_t* batch_order;  // out: per batch, its balls in groups (room for lanes - 1 more at the end)
+  BatchReach* reach;           // out, threaded builds only: per batch, the balls its stored lists name
 };
 
 // One ball's stored list: neighbour k is listed_index(first[k * lanes]).
@@ -206,6 +218,7 @@ class NeighbourList {
   const std::uint32_t* neighbours() const { return neighbours_.get(); }
   const std::uint32_t* counts() const { return counts_.data(); }
   const std::uint32_t* batch_order() const { return batch_order_.data(); }
+  const BatchReach* batch_reach() const { return reach_.data(); }
 
   // Calls visit(i, ListView) once for each ball of the last build, batch by
   // batch in the layout's order.
@@ -236,6 +249,7 @@ class NeighbourList {
   std::size_t neighbours_room_ = 0;
   std::vector<std::uint32_t> counts_;
   std::vector<std::uint32_t> batch_order_;
+  std::vector<BatchReach> reach_;
   AlignedVector<float> axes_;  // x, y, z, radius of the sorted balls, axis by axis (ListBuild)
 };
 

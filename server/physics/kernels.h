@@ -26,6 +26,14 @@
 
 namespace fishtank {
 
+// Rows [rows_begin, rows_end) of this step's pos and vel_half, for the SIMD
+// step to ask for while it runs batches first_batch..end_batch - 1 (numbered
+// by ball / kStepBatch), each group its share of the cache lines.
+struct RowFetch {
+  std::uint32_t rows_begin = 0, rows_end = 0;
+  std::uint32_t first_batch = 0, end_batch = 0;
+};
+
 struct StepArrays {
   const Float4* pos;       // x, y, z, radius at this step
   const Float4* vel_half;  // vx, vy, vz, mass: velocity half a step before
@@ -51,6 +59,10 @@ struct StepArrays {
   // (World::lists_hold). The default lists none.
   float far_d2 = std::numeric_limits<float>::infinity();
   std::uint32_t* far_balls = nullptr;
+  // The rows at a chunk's edges that another thread's batches read too
+  // (World::edge_fetches); none by default. The scalar twin runs on one
+  // thread, with no edges, and ignores them.
+  RowFetch edge_fetch[2] = {};
 };
 
 // How far the balls of a chunk moved from where the lists were built.

@@ -98,10 +98,14 @@ std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t
   std::uint32_t longest = 0;
   for (std::uint32_t batch = begin, last_of_batch; batch < end; batch = last_of_batch) {
     last_of_batch = batch_end(batch, end);
+    BatchReach reach;  // a local: stores to the lists cannot change it
     for (std::uint32_t i = batch; i < last_of_batch; ++i) {
-      b.counts[i] = list_of(b, i, rows.data() + std::size_t(i - batch) * b.stride);
+      std::uint32_t* const row = rows.data() + std::size_t(i - batch) * b.stride;
+      b.counts[i] = list_of(b, i, row);
       longest = std::max(longest, b.counts[i]);
+      for (std::uint32_t k = 0; k < std::min(b.counts[i], b.stride); ++k) reach.add(row[k]);
     }
+    b.reach[batch / kStepBatch] = reach;
     std::uint32_t* order = b.batch_order + batch;
     const std::uint32_t grouped = by_neighbour_count(b.counts, batch, last_of_batch, kLanes, order);
     std::uint32_t* block = b.neighbours + std::size_t(batch) * b.stride;
@@ -257,6 +261,24 @@ template <std::uint32_t kCount>
     prefetch<false>(s.neighbours, lists + line);
 }
 
+// Asks for this group's share of a RowFetch's cache lines, when `batch` (a
+// batch number) is in its window; `share` is the group's place in its batch.
+template <std::uint32_t kCount>
+[[gnu::always_inline]] inline void fetch_rows(const StepArrays& s, const RowFetch& f, std::uint32_t batch,
+                                              std::uint32_t share) {
+  if (batch < f.first_batch || batch >= f.end_batch) return;
+  constexpr std::size_t kGroups = kStepBatch / kCount;
+  const std::size_t first_line = f.rows_begin * sizeof(Float4) / kCacheLine;
+  const std::size_t end_line = (f.rows_end * sizeof(Float4) + kCacheLine - 1) / kCacheLine;
+  const std::size_t groups = (f.end_batch - f.first_batch) * kGroups;
+  const std::size_t per_group = (end_line - first_line + groups - 1) / groups;
+  const std::size_t from = first_line + ((batch - f.first_batch) * kGroups + share) * per_group;
+  for (std::size_t line = from; line < std::min(end_line, from + per_group); ++line) {
+    prefetch<false>(s.pos, line * kCacheLine);
+    prefetch<false>(s.vel_half, line * kCacheLine);
+  }
+}
+
 // Each pass takes a batch's groups (kStepBatch, broadphase.h), one ball per
 // lane: the neighbour sums from the group's blocks, walls and players give
 // a = F / m + g for the group's balls at once, and per_group(at, i, ax, ay,
@@ -273,6 +295,7 @@ template <class V, class PerGroup>
     const std::uint32_t* const groups_end = group + grouped_length(batch_end(batch, end) - batch, kCount);
     for (std::uint32_t share = 0; group < groups_end; group += kCount, ++share) {
       if (s.beyond_cache) prefetch_next_batch<kCount>(s, batch, share);
+      for (const RowFetch& f : s.edge_fetch) fetch_rows<kCount>(s, f, batch / kStepBatch, share);
       std::uint32_t blocks = 0, at[kCount];
       for (std::uint32_t l = 0; l < kCount; ++l) {
         blocks = std::max(blocks, s.neighbour_count[group[l]]);

@@ -144,6 +144,7 @@ class World {
   void resize(std::uint32_t n);
   void set_ghost();
   StepArrays arrays();
+  void add_edge_fetches(StepArrays& s, std::uint32_t begin, std::uint32_t end) const;
 
   PhysicsParams params_;
   ContactModel model_;

@@ -1,6 +1,7 @@
 // Every list-build kernel finds exactly the pairs within r_i + r_j + skin, in
 // the same order, however many of the neighbouring cells a ball's reach lets
-// it skip, and reports lists that do not fit instead of overrunning.
+// it skip, reports lists that do not fit instead of overrunning, and says
+// which balls each batch's lists reach.
 
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -57,6 +58,16 @@ Lists build(const Kernels& kernels, const TankBounds& tank, const AlignedVector<
   });
   // The layout holds each ball's list exactly once.
   REQUIRE(std::count(seen.begin(), seen.end(), 1) == std::ptrdiff_t(n));
+  // Each batch's reach is the lowest and the highest ball its lists name
+  // (the threaded builds say: only they have chunk edges to look after).
+  for (std::uint32_t batch = 0; kernels.threaded && batch * kStepBatch < n; ++batch) {
+    BatchReach expected;
+    for (std::uint32_t i = batch * kStepBatch; i < batch_end(batch * kStepBatch, n); ++i)
+      for (std::uint32_t j : out.entries[i]) expected.add(j);
+    INFO("batch " << batch);
+    REQUIRE(list.batch_reach()[batch].lowest == expected.lowest);
+    REQUIRE(list.batch_reach()[batch].highest == expected.highest);
+  }
   return out;
 }
 
