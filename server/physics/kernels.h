@@ -60,9 +60,13 @@ struct StepArrays {
   float far_d2 = std::numeric_limits<float>::infinity();
   std::uint32_t* far_balls = nullptr;
   // The rows at a chunk's edges that another thread's batches read too
-  // (World::edge_fetches); none by default. The scalar twin runs on one
+  // (World::add_edge_fetches); none by default. The scalar twin runs on one
   // thread, with no edges, and ignores them.
   RowFetch edge_fetch[2] = {};
+  // The batches [lead_begin, lead_end) of the chunk (ball indices) run first,
+  // then the others in order: the rows of edge_fetch's first window arrive
+  // while they run. None by default; the scalar twin ignores it too.
+  std::uint32_t lead_begin = 0, lead_end = 0;
 };
 
 // How far the balls of a chunk moved from where the lists were built.

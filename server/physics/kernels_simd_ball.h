@@ -286,31 +286,42 @@ template <std::uint32_t kCount>
 // to their rows at list entries `at`. A padded group repeats a ball: it is
 // computed twice and stored twice, with the same result.
 template <class V, class PerGroup>
+[[gnu::always_inline]] inline void for_each_group_of_batch(const StepArrays& s, const ContactModel& m,
+                                                           std::uint32_t batch, std::uint32_t end,
+                                                           PerGroup& per_group) {
+  constexpr std::uint32_t kCount = Lanes<V>::kCount;
+  const std::uint32_t* block = s.neighbours + std::size_t(batch) * s.stride;
+  const std::uint32_t* group = s.batch_order + batch;
+  const std::uint32_t* const groups_end = group + grouped_length(batch_end(batch, end) - batch, kCount);
+  for (std::uint32_t share = 0; group < groups_end; group += kCount, ++share) {
+    if (s.beyond_cache) prefetch_next_batch<kCount>(s, batch, share);
+    for (const RowFetch& f : s.edge_fetch) fetch_rows<kCount>(s, f, batch / kStepBatch, share);
+    std::uint32_t blocks = 0, at[kCount];
+    for (std::uint32_t l = 0; l < kCount; ++l) {
+      blocks = std::max(blocks, s.neighbour_count[group[l]]);
+      at[l] = list_entry(group[l]);
+    }
+    GroupBalls<V> i;
+    Lanes<V>::load(s.pos, at, i.x, i.y, i.z, i.r);
+    Lanes<V>::load(s.vel_half, at, i.vx, i.vy, i.vz, i.m);
+    V ax, ay, az;
+    neighbour_forces(s, m, block, blocks, i, ax, ay, az);
+    acceleration(s, m, i, ax, ay, az);
+    per_group(at, i, ax, ay, az);
+    block += std::size_t(blocks) * kCount;
+  }
+}
+
+// The chunk's lead batches first (StepArrays::lead_begin), then the others in order.
+template <class V, class PerGroup>
 [[gnu::always_inline]] inline void for_each_group(const StepArrays& s, const ContactModel& m, std::uint32_t begin,
                                                   std::uint32_t end, PerGroup per_group) {
-  constexpr std::uint32_t kCount = Lanes<V>::kCount;
-  for (std::uint32_t batch = begin; batch < end; batch += kStepBatch) {
-    const std::uint32_t* block = s.neighbours + std::size_t(batch) * s.stride;
-    const std::uint32_t* group = s.batch_order + batch;
-    const std::uint32_t* const groups_end = group + grouped_length(batch_end(batch, end) - batch, kCount);
-    for (std::uint32_t share = 0; group < groups_end; group += kCount, ++share) {
-      if (s.beyond_cache) prefetch_next_batch<kCount>(s, batch, share);
-      for (const RowFetch& f : s.edge_fetch) fetch_rows<kCount>(s, f, batch / kStepBatch, share);
-      std::uint32_t blocks = 0, at[kCount];
-      for (std::uint32_t l = 0; l < kCount; ++l) {
-        blocks = std::max(blocks, s.neighbour_count[group[l]]);
-        at[l] = list_entry(group[l]);
-      }
-      GroupBalls<V> i;
-      Lanes<V>::load(s.pos, at, i.x, i.y, i.z, i.r);
-      Lanes<V>::load(s.vel_half, at, i.vx, i.vy, i.vz, i.m);
-      V ax, ay, az;
-      neighbour_forces(s, m, block, blocks, i, ax, ay, az);
-      acceleration(s, m, i, ax, ay, az);
-      per_group(at, i, ax, ay, az);
-      block += std::size_t(blocks) * kCount;
-    }
-  }
+  const bool led = s.lead_begin < s.lead_end;
+  const std::uint32_t lead_begin = led ? s.lead_begin : begin, lead_end = led ? s.lead_end : begin;
+  const std::uint32_t from[3] = {lead_begin, begin, lead_end}, to[3] = {lead_end, lead_begin, end};
+  for (int part = 0; part < 3; ++part)
+    for (std::uint32_t batch = from[part]; batch < to[part]; batch += kStepBatch)
+      for_each_group_of_batch<V>(s, m, batch, end, per_group);
 }
 
 template <class V>

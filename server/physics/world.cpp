@@ -244,7 +244,8 @@ StepArrays World::arrays() {
 // overlap instead of stalling the batches one miss at a time (technical
 // report, 6.1):
 //  - below its first ball: the rows its first batches read, written by the
-//    thread below at the end of its last step, at once;
+//    thread below at the end of its last step, at once, while the chunk
+//    runs first the two batches after those that read them;
 //  - around its last ball: its own rows that the thread above reads, and
 //    the rows above that it reads itself, over the few batches before the
 //    first one that reads them.
@@ -264,9 +265,13 @@ void World::add_edge_fetches(StepArrays& s, std::uint32_t begin, std::uint32_t e
       *fetch++ = f;
   };
   if (begin > 0) {
-    std::uint32_t lowest = begin;
+    std::uint32_t lowest = begin, lead = first;  // lead: the first batch that reads no row below
     for (std::uint32_t b = first; b < last; ++b) lowest = std::min(lowest, reach[b].lowest);
-    add({lowest, begin, first, std::min(last, first + kBelowWindow)});
+    while (lead < last && reach[lead].lowest < begin) ++lead;
+    if (lead == last) lead = first;  // every batch reads below: no batch to run meanwhile
+    const std::uint32_t lead_end = std::min(last, lead + kBelowWindow);
+    if (lead > first) s.lead_begin = lead * kStepBatch, s.lead_end = std::min(end, lead_end * kStepBatch);
+    add({lowest, begin, lead, lead_end});
   }
   if (end < n_) {
     std::uint32_t lowest = end, highest = end - 1;  // [lowest, highest]: rows both threads read
