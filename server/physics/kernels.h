@@ -14,8 +14,10 @@
 // (pos, vel_half) of ball i and its neighbours and writes only ball i's
 // outputs, so chunks run in parallel with no races and no atomics:
 //   a    = F(pos, vel_half) / m + g
-//   vel  = vel_half + a dt/2                 (the full step, what observers see)
-//   vel_half_next = vel + a dt/2,  pos_next = pos + vel_half_next dt
+//   v    = vel_half + a dt/2                 (the full step, not stored)
+//   vel_half_next = v + a dt/2,  pos_next = pos + vel_half_next dt
+// Observers' full-step velocity is the mean of vel_half and vel_half_next,
+// derived when someone asks (World::velocities).
 
 #include <cstdint>
 #include <limits>
@@ -37,7 +39,6 @@ struct RowFetch {
 struct StepArrays {
   const Float4* pos;       // x, y, z, radius at this step
   const Float4* vel_half;  // vx, vy, vz, mass: velocity half a step before
-  Float4* vel;             // out: vx, vy, vz, mass at this step
   Float4* pos_next;        // out: position one step later
   Float4* vel_half_next;   // out: velocity half a step later
   const Float4* pos_at_build;

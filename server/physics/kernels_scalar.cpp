@@ -101,7 +101,6 @@ Moved step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
       const Float4 a = acceleration(s, m, i, pair_force[i - batch]);
       const Float4 vh = s.vel_half[i];
       const Float4 v{vh.x + a.x * m.half_dt, vh.y + a.y * m.half_dt, vh.z + a.z * m.half_dt, vh.w};
-      s.vel[i] = v;
       const float d2 = kick_drift(m, v, s.pos[i], a, s.pos_at_build[i], s.vel_half_next[i], s.pos_next[i]);
       moved.max_d2 = std::max(moved.max_d2, d2);
       if (d2 > s.far_d2) s.far_balls[begin + moved.far++] = i;

@@ -251,7 +251,6 @@ template <std::uint32_t kCount>
     prefetch<false>(s.pos, line);
     prefetch<false>(s.vel_half, line);
     prefetch<false>(s.pos_at_build, line);
-    prefetch<true>(s.vel, line);
     prefetch<true>(s.pos_next, line);
     prefetch<true>(s.vel_half_next, line);
   }
@@ -337,7 +336,6 @@ Moved step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
   for_each_group<V>(s, m, begin, end, [&](const std::uint32_t* at, const GroupBalls<V>& i, V ax, V ay, V az) {
     const V half_dt = V::splat(m.half_dt), dt = V::splat(m.dt);
     const V vx = mul_add(ax, half_dt, i.vx), vy = mul_add(ay, half_dt, i.vy), vz = mul_add(az, half_dt, i.vz);
-    Lanes<V>::store(vx, vy, vz, i.m, s.vel, at);
     const V hx = mul_add(ax, half_dt, vx), hy = mul_add(ay, half_dt, vy), hz = mul_add(az, half_dt, vz);
     Lanes<V>::store(hx, hy, hz, i.m, s.vel_half_next, at);
     const V px = mul_add(hx, dt, i.x), py = mul_add(hy, dt, i.y), pz = mul_add(hz, dt, i.z);

@@ -15,6 +15,9 @@
 //
 // Between steps pos and vel are the state at time(); the next step's
 // positions are already computed, so one pass and one barrier make a step.
+// The pass does not store vel: it is the mean of the half-step velocities on
+// either side, derived when asked for (velocities(), ball(), the energies,
+// the hash), not every step.
 //
 // Ball arrays are reordered by every rebuild; id() gives each ball's
 // permanent number (its order of appearance) for anyone who tracks balls.
@@ -106,7 +109,7 @@ class World {
 
   // Current (sorted) order; index with i < ball_count().
   const Float4* positions() const { return pos_.data(); }
-  const Float4* velocities() const { return vel_.data(); }
+  const Float4* velocities() const;
   const std::uint8_t* kinds() const { return kind_.data(); }
   const std::uint32_t* ids() const { return id_.data(); }
   // The ball with permanent number id (linear search: for tests and tools).
@@ -144,6 +147,7 @@ class World {
   void resize(std::uint32_t n);
   void set_ghost();
   StepArrays arrays();
+  void derive_velocities() const;
   void add_edge_fetches(StepArrays& s, std::uint32_t begin, std::uint32_t end) const;
 
   PhysicsParams params_;
@@ -155,9 +159,13 @@ class World {
 
   std::uint32_t n_ = 0;
   // n_ balls, then kGhostSlots ghosts far away (index n_ pads neighbour lists).
-  AlignedVector<Float4> pos_, vel_, vel_half_;
+  AlignedVector<Float4> pos_, vel_half_;
   AlignedVector<Float4> pos_next_, vel_half_next_;  // written by the step pass
-  AlignedVector<Float4> acc_;                       // scratch: start_from_current_state(), rebuild()
+  // The full-step velocity at time(): stale after a pass until derived from
+  // vel_half_ and vel_half_next_ (derive_velocities).
+  mutable AlignedVector<Float4> vel_;
+  mutable bool vel_stale_ = false;
+  AlignedVector<Float4> acc_;  // scratch: start_from_current_state(), rebuild()
   AlignedVector<Float4> pos_at_build_;
   std::vector<std::uint8_t> kind_, kind_scratch_;
   std::vector<std::uint32_t> id_, id_scratch_;

@@ -98,23 +98,15 @@ struct DenseScene {
   // output value's bits.
   std::vector<std::uint32_t> step_bits(const Kernels& kernels, const std::vector<std::uint32_t>& bounds,
                                        const std::uint32_t* neighbours, const std::uint32_t* batch_order) const {
-    AlignedVector<Float4> vel(n), pos_next(n), vel_half_next(n);
-    const StepArrays s{pos.data(),
-                       vel_half.data(),
-                       vel.data(),
-                       pos_next.data(),
-                       vel_half_next.data(),
-                       pos.data(),
-                       neighbours,
-                       list.counts(),
-                       list.stride(),
-                       batch_order,
-                       nullptr,
-                       nullptr,
-                       0};
+    AlignedVector<Float4> pos_next(n), vel_half_next(n);
+    const StepArrays s{
+        pos.data(),  vel_half.data(), pos_next.data(), vel_half_next.data(),
+        pos.data(),  neighbours,      list.counts(),   list.stride(),
+        batch_order, nullptr,         nullptr,         0,
+    };
     for (std::size_t r = 0; r + 1 < bounds.size(); ++r) kernels.step(s, model, bounds[r], bounds[r + 1]);
     std::vector<std::uint32_t> bits;
-    for (const AlignedVector<Float4>* out : {&vel, &pos_next, &vel_half_next})
+    for (const AlignedVector<Float4>* out : {&pos_next, &vel_half_next})
       for (const Float4& f : *out)
         for (float x : {f.x, f.y, f.z, f.w}) {
           std::uint32_t b;
