@@ -33,6 +33,7 @@ inline constexpr std::array<BallKind, 3> kBallKinds{{
     {3.0f, 3.0f, {50, 90, 230}},
 }};
 inline constexpr int kKindCount = static_cast<int>(kBallKinds.size());
+inline constexpr float kMinBallDiameter = 1.0f;
 inline constexpr float kMaxBallDiameter = 3.0f;
 inline constexpr float kPlayerDiameter = 1.0f;
 

@@ -74,13 +74,22 @@ ListBuild NeighbourList::grid_view() const {
   return grid;
 }
 
-bool NeighbourList::misses_contact(std::uint32_t i, const Float4* pos, const Float4* at_build) const {
+bool NeighbourList::can_check(float radius, float moved) const {
+  // Past the skin, a margin for the rounding of the cells' assignment (sort()).
+  constexpr float kCellMargin = 0.01f;
+  const float reach = radius + 0.5f * kMaxBallDiameter + moved;
+  return moved <= skin_ || reach + kCellMargin <= std::min({edge_.x, edge_.y, edge_.z});
+}
+
+bool NeighbourList::misses_contact(std::uint32_t i, const Float4* pos, const Float4* at_build, float moved) const {
   // Relative margins keep the answer on the safe side of float rounding: a
   // pair counts as touching a little early, and as listed only if it was
   // clearly inside the build's cutoff.
   constexpr float kTouchMargin = 1.0f + 1e-5f, kListedMargin = 1.0f - 1e-5f;
-  const ListBuild grid = grid_view();
   const Float4 p = pos[i], b = at_build[i];
+  if (!can_check(p.w, moved)) return true;
+  ListBuild grid = grid_view();
+  grid.skin = std::max(skin_, moved);  // the search's reach: r_i + the largest radius + this
   bool missing = false;
   for_each_range_within_reach(grid, cell_of(p), p, [&](std::uint32_t j_begin, std::uint32_t j_end) {
     for (std::uint32_t j = j_begin; j < j_end && !missing; ++j) {

@@ -18,9 +18,9 @@
 // The list stays valid while no ball has moved more than skin / 2 since the
 // build (two balls closing by skin / 2 each could then touch unseen), the
 // LAMMPS criterion. Past that the world keeps it as long as the few balls
-// that moved further, up to skin, touch only balls in their lists
-// (misses_contact): in a million-ball scene the fastest balls are a thin
-// tail, and half the rebuilds were for them alone.
+// that moved further touch only balls in their lists (misses_contact, for as
+// long as its search reaches: can_check): in a million-ball scene the fastest
+// balls are a thin tail, and most rebuilds were for them alone.
 
 #include <algorithm>
 #include <cstddef>
@@ -204,11 +204,18 @@ class NeighbourList {
 
   // Whether ball i, now at pos[i], touches a ball that its list lacks: one
   // whose position at the last build (at_build) was beyond the list's reach.
-  // Valid while no ball has moved more than skin since that build (a ball
-  // that touches i now is then still within the cells the build's reach
-  // covers around i); the world checks this for the few balls that moved more
-  // than skin / 2 instead of rebuilding for them (world.cpp, lists_hold()).
-  bool misses_contact(std::uint32_t i, const Float4* pos, const Float4* at_build) const;
+  // `moved` is the furthest any ball has moved since that build: a ball that
+  // touches i now was then within r_i + the largest radius + moved of where i
+  // is now, and the search covers the cells around i's up to that distance.
+  // The world checks this for the few balls that moved more than skin / 2
+  // instead of rebuilding for them (world.cpp, lists_hold()). Also true when
+  // the search cannot tell (can_check).
+  bool misses_contact(std::uint32_t i, const Float4* pos, const Float4* at_build, float moved) const;
+  // Whether misses_contact can vouch for a ball of this radius after balls
+  // moved up to `moved`: always up to the skin (cells are the largest diameter
+  // + skin wide), beyond it while r + the largest radius + moved still fits
+  // in a cell, so that the cells around the ball's hold every ball it can touch.
+  bool can_check(float radius, float moved) const;
 
   // Room for `stride` neighbours of each of n balls, laid out in groups of
   // `lanes` (Kernels::list_lanes of the build that fills them).

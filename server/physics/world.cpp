@@ -329,12 +329,14 @@ bool World::lists_hold() {
   // Two balls that each moved at most skin / 2 since the build cannot have
   // closed the skin between them unseen. Past that the lists are kept while
   // every ball that moved further (a few fast ones, the step pass lists them)
-  // touches only balls in its list, checked one by one, up to the distance
-  // skin, which the check's search covers (NeighbourList::misses_contact).
-  // Beyond a few such balls a rebuild is cheaper.
-  const float skin = params_.skin;
+  // touches only balls in its list, checked one by one for as long as the
+  // check's search reaches (NeighbourList::can_check: for a small ball, until
+  // the fastest has moved about six skins). Beyond a few such balls a rebuild
+  // is cheaper.
   if (next_max_d2_ <= half_skin_d2()) return true;
-  if (!(next_max_d2_ <= skin * skin) || !far_listed_) return false;  // NaN too
+  if (!far_listed_ || !std::isfinite(next_max_d2_)) return false;
+  const float moved = std::sqrt(next_max_d2_);
+  if (!list_.can_check(0.5f * kMinBallDiameter, moved)) return false;  // not even for the smallest ball
   // Each chunk listed its far balls from its begin: gather them to the front.
   std::uint32_t far = 0;
   for (const ChunkMoved& chunk : thread_moved_) {
@@ -346,7 +348,7 @@ bool World::lists_hold() {
   std::fill(thread_missing_.begin(), thread_missing_.end(), 0);
   pool_.run(far, [&](std::uint32_t begin, std::uint32_t end, int thread) {
     for (std::uint32_t k = begin; k < end && !thread_missing_[thread]; ++k)
-      thread_missing_[thread] = list_.misses_contact(far_balls_[k], pos_.data(), pos_at_build_.data());
+      thread_missing_[thread] = list_.misses_contact(far_balls_[k], pos_.data(), pos_at_build_.data(), moved);
   });
   if (std::find(thread_missing_.begin(), thread_missing_.end(), 1) != thread_missing_.end()) return false;
   ++lists_kept_far_;

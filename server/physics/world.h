@@ -182,9 +182,9 @@ class World {
   std::uint32_t max_balls_;
   // Up to n / kFarBallsPerCheck (+ 16) balls further than skin / 2 from
   // where the lists were built are checked instead of rebuilding. A check
-  // scans about the candidates of one ball's list build, so even at that
-  // count the checks of the (at most ten or so) steps before a ball reaches
-  // the whole skin cost a few percent of the rebuild they put off.
+  // scans about the candidates of one ball's list build (up to three times
+  // as many once the fastest ball moved well past the skin), so even at that
+  // count a step's checks cost about 1 % of the rebuild they put off.
   static constexpr std::uint32_t kFarBallsPerCheck = 256;
   static constexpr float kFarMargin = 1.0f - 1e-5f;  // a ball right at skin / 2 counts as far
   // What each thread's chunk of the last step pass reported.

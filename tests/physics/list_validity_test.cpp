@@ -85,9 +85,9 @@ TEST_CASE("two balls closing head-on from beyond the skin get a rebuild before t
           "[physics][broadphase]") {
   // Each pair starts skin * (1 + extra) apart, beyond each other's lists, and
   // closes at 20 + 20 or 20 + 8 units/s: they touch when the faster has moved
-  // more than the half skin after which the lists are only kept if checked,
-  // and less than the whole skin that forces a rebuild (with 20 + 8 the
-  // slower ball stays under the half skin: only the faster one is checked).
+  // more than the half skin after which the lists are only kept if checked
+  // (with 20 + 8 the slower ball stays under the half skin: only the faster
+  // one is checked).
   // Only the check of the far balls can see the contact coming; nothing else
   // moves.
   const std::string variant = GENERATE(from_range(variant_names()));
@@ -105,4 +105,36 @@ TEST_CASE("two balls closing head-on from beyond the skin get a rebuild before t
   CHECK(contacts > 0);                // they met...
   CHECK(world.lists_kept_far() > 0);  // ...after steps with far balls and kept lists
   CHECK(world.rebuilds() >= 2);       // and a rebuild came before each contact
+}
+
+TEST_CASE("the check finds a contact between two balls that both moved well past the skin", "[physics][broadphase]") {
+  // Two small balls, 3.5 apart at the build, each moved 1.25 towards the
+  // other and now touch. From where ball a is now, b's position at the build
+  // lies 2.25 away, in the next cell along x, whose face is 2.23 away: a
+  // search that reached only r_a + the largest radius + skin (2.2) would skip
+  // that cell and miss the contact; the check widens its reach by how far
+  // balls have moved.
+  TankBounds tank;  // 40 units, 12 cells of 3.33 per axis: a face at x = 6.667
+  const float face = tank.min.x + 8.0f * tank.size().x / 12.0f, moved = 1.25f;
+  const Float4 a_now{face - 2.23f, 21.5f, 1.5f, 0.5f}, b_now{a_now.x + 1.0f, 21.5f, 1.5f, 0.5f};
+  const Float4 a_build{a_now.x - moved, 21.5f, 1.5f, 0.5f}, b_build{a_now.x + 2.25f, 21.5f, 1.5f, 0.5f};
+
+  NeighbourList list;
+  list.configure(tank, 0.2f);
+  AlignedVector<Float4> at_build{a_build, b_build}, now{a_now, b_now};
+  for (std::uint32_t g = 0; g < kGhostSlots; ++g) at_build.push_back(kGhostPos), now.push_back(kGhostPos);
+  std::vector<std::uint32_t> order;
+  list.sort(at_build.data(), 2, order);
+  REQUIRE(order == std::vector<std::uint32_t>{0, 1});  // a's cell comes first: indices stay
+
+  REQUIRE(list.can_check(0.5f, moved));
+  CHECK(list.misses_contact(0, now.data(), at_build.data(), moved));
+  // Apart again, nothing is missing.
+  now[1].x += 0.1f;
+  CHECK_FALSE(list.misses_contact(0, now.data(), at_build.data(), moved));
+  // Beyond what a cell holds the check cannot tell, and says so.
+  CHECK_FALSE(list.can_check(0.5f, 1.4f));
+  CHECK(list.can_check(1.5f, 0.3f));
+  CHECK_FALSE(list.can_check(1.5f, 0.35f));
+  CHECK(list.misses_contact(0, now.data(), at_build.data(), 1.4f));
 }
