@@ -67,14 +67,14 @@ std::vector<double> WorkerPool::shares(int active) const {
   return share;
 }
 
-void WorkerPool::split(std::uint32_t count) {
+void WorkerPool::split(std::uint32_t count, std::uint32_t granule) {
   const double total = std::accumulate(speed_.begin(), speed_.begin() + active_, 0.0);
   double before = 0.0;
   chunk_start_[0] = 0;
   for (int t = 1; t < active_; ++t) {
     before += speed_[t - 1];
     // The nearest multiple of the granule: rounding down would hand the last thread up to a granule more.
-    const double start = std::floor(count * (before / total) / granule_ + 0.5) * granule_;
+    const double start = std::floor(count * (before / total) / granule + 0.5) * granule;
     chunk_start_[t] = std::max(chunk_start_[t - 1], static_cast<std::uint32_t>(std::min<double>(count, start)));
   }
   chunk_start_[active_] = count;
@@ -112,12 +112,20 @@ void WorkerPool::balance() {
   }
 }
 
-void WorkerPool::run(std::uint32_t count, const Phase& phase) { run(count, phase, false); }
+void WorkerPool::run(std::uint32_t count, const Phase& phase) {
+  run(count, phase, {granule_, kMinItemsPerThread}, false);
+}
 
-void WorkerPool::run_and_balance(std::uint32_t count, const Phase& phase) { run(count, phase, true); }
+void WorkerPool::run_and_balance(std::uint32_t count, const Phase& phase) {
+  run(count, phase, {granule_, kMinItemsPerThread}, true);
+}
 
-void WorkerPool::run(std::uint32_t count, const Phase& phase, bool timed) {
-  const int useful = static_cast<int>(std::min<std::uint32_t>(count / kMinItemsPerThread, active_limit_));
+void WorkerPool::run_costly(std::uint32_t count, std::uint32_t min_per_thread, const Phase& phase) {
+  run(count, phase, {1, std::max(1u, min_per_thread)}, false);
+}
+
+void WorkerPool::run(std::uint32_t count, const Phase& phase, Grain grain, bool timed) {
+  const int useful = static_cast<int>(std::min<std::uint32_t>(count / grain.min_per_thread, active_limit_));
   if (useful <= 1) {
     if (count > 0) phase(0, count, 0);
     return;
@@ -125,7 +133,7 @@ void WorkerPool::run(std::uint32_t count, const Phase& phase, bool timed) {
   phase_ = &phase;
   active_ = useful;
   timed_ = timed;
-  split(count);
+  split(count, grain.granule);
   pending_.store(thread_count_ - 1, std::memory_order_relaxed);
   {
     // Taking the lock orders the publish against a worker that is about to sleep.

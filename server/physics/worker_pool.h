@@ -57,6 +57,10 @@ class WorkerPool {
   // The same, timing each thread's chunk to adapt later splits: for the pass
   // that takes most of the time, whose chunks' speeds the split should match.
   void run_and_balance(std::uint32_t count, const Phase& phase);
+  // For items that each cost as much as hundreds of balls' steps (a far
+  // ball's check): splits from `min_per_thread` items per thread, in chunks
+  // of any length, by the same speeds.
+  void run_costly(std::uint32_t count, std::uint32_t min_per_thread, const Phase& phase);
   // Each thread's fraction of the items in a run on `active` threads.
   std::vector<double> shares(int active) const;
   // Wakes sleeping workers now so that they are polling, not asleep, when a
@@ -75,8 +79,13 @@ class WorkerPool {
 
   void worker_loop(int thread);
   void run_chunk(int thread);
-  void run(std::uint32_t count, const Phase& phase, bool timed);
-  void split(std::uint32_t count);
+  // What a run's items cost: chunks start at multiples of `granule`, and a
+  // run is split only with at least `min_per_thread` items per thread.
+  struct Grain {
+    std::uint32_t granule, min_per_thread;
+  };
+  void run(std::uint32_t count, const Phase& phase, Grain grain, bool timed);
+  void split(std::uint32_t count, std::uint32_t granule);
   void balance();
 
   int thread_count_;

@@ -1,7 +1,7 @@
 // The worker pool hands every item to exactly one thread, in chunks that
-// start at multiples of its granule, and run_and_balance() moves the split
-// towards chunks that take equal time when the threads run at different
-// speeds (a slow core of a virtual machine).
+// start at multiples of its granule (of any length for costly items), and
+// run_and_balance() moves the split towards chunks that take equal time when
+// the threads run at different speeds (a slow core of a virtual machine).
 
 #include "server/physics/worker_pool.h"
 
@@ -28,20 +28,27 @@ void busy_until(std::chrono::steady_clock::time_point until) {
 
 TEST_CASE("every item goes to exactly one thread, in chunks starting at multiples of the granule", "[pool]") {
   constexpr std::uint32_t kGranule = 128;
+  enum class Run { kPlain, kBalanced, kCostly };
   for (int threads : {1, 2, 4}) {
     WorkerPool pool(threads, kGranule);
-    for (std::uint32_t count : {0u, 100u, 4096u, 10000u, 12345u}) {
-      for (bool balanced : {false, true}) {
+    for (std::uint32_t count : {0u, 7u, 100u, 4096u, 10000u, 12345u}) {
+      for (Run run : {Run::kPlain, Run::kBalanced, Run::kCostly}) {
         std::unique_ptr<std::atomic<int>[]> seen(new std::atomic<int>[count]());
         std::atomic<bool> misaligned{false};
+        std::atomic<int> chunks{0};
         const WorkerPool::Phase phase = [&](std::uint32_t begin, std::uint32_t end, int) {
           if (begin % kGranule != 0) misaligned = true;
+          ++chunks;
           for (std::uint32_t i = begin; i < end; ++i) seen[i].fetch_add(1);
         };
-        balanced ? pool.run_and_balance(count, phase) : pool.run(count, phase);
-        INFO(threads << " threads, " << count << " items, balanced " << balanced);
-        CHECK_FALSE(misaligned);
+        if (run == Run::kPlain) pool.run(count, phase);
+        if (run == Run::kBalanced) pool.run_and_balance(count, phase);
+        if (run == Run::kCostly) pool.run_costly(count, 3, phase);
+        INFO(threads << " threads, " << count << " items, run " << int(run));
         CHECK(std::all_of(seen.get(), seen.get() + count, [](const std::atomic<int>& s) { return s == 1; }));
+        if (run != Run::kCostly) CHECK_FALSE(misaligned);
+        // Costly items are split from three per thread, whatever the granule.
+        if (run == Run::kCostly && count > 0) CHECK(chunks == std::min<int>(threads, std::max<int>(1, count / 3)));
       }
     }
   }
