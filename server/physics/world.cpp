@@ -407,8 +407,9 @@ double World::kinetic_energy() const {
 }
 
 double World::potential_energy() const {
+  derive_velocities();  // vel_'s w is the mass, also of balls placed since the last step
   double e = 0.0;
-  for (std::uint32_t i = 0; i < n_; ++i) e += double(vel_half_[i].w) * model_.gravity * pos_[i].y;  // w: mass
+  for (std::uint32_t i = 0; i < n_; ++i) e += double(vel_[i].w) * model_.gravity * pos_[i].y;
   return e;
 }
 
