@@ -67,16 +67,25 @@ TEST_CASE("balanced runs give a thread three times slower a quarter of the items
   };
   pool.run(kItems, phase);  // untimed runs leave the split alone
   REQUIRE(pool.shares(2) == std::vector<double>{0.5, 0.5});
-  for (int run = 0; run < 40; ++run) pool.run_and_balance(kItems, phase);
-  const std::vector<double> shares = pool.shares(2);
-  INFO("thread 0 " << shares[0] << ", thread 1 " << shares[1]);
-  CHECK(shares[1] == Approx(0.25).margin(0.06));
-  CHECK(shares[0] + shares[1] == Approx(1.0));
+  // Thread 1's share over the last 15 of 40 runs, by its median: one run in
+  // which the machine stalled a thread moves a share for a few runs only.
+  const auto settled_share = [&](const WorkerPool::Phase& p) {
+    std::vector<double> last;
+    for (int run = 0; run < 40; ++run) {
+      pool.run_and_balance(kItems, p);
+      if (run >= 25) last.push_back(pool.shares(2)[1]);
+    }
+    std::nth_element(last.begin(), last.begin() + last.size() / 2, last.end());
+    return last[last.size() / 2];
+  };
+  const double slow_share = settled_share(phase);
+  INFO("thread 1's share " << slow_share);
+  CHECK(slow_share == Approx(0.25).margin(0.06));
+  CHECK(pool.shares(2)[0] + pool.shares(2)[1] == Approx(1.0));
 
   // When the threads become equal again, so does the split.
   const WorkerPool::Phase equal = [](std::uint32_t begin, std::uint32_t end, int) {
     busy_until(std::chrono::steady_clock::now() + std::chrono::microseconds(5) * (end - begin));
   };
-  for (int run = 0; run < 40; ++run) pool.run_and_balance(kItems, equal);
-  CHECK(pool.shares(2)[1] == Approx(0.5).margin(0.06));
+  CHECK(settled_share(equal) == Approx(0.5).margin(0.06));
 }
