@@ -74,7 +74,8 @@ inline std::uint32_t grouped_length(std::uint32_t count, std::uint32_t lanes) {
 
 // The balls a batch's lists name lie in [lowest, highest] (lowest > highest
 // when they name none). Batches near a chunk's edge name balls of the
-// neighbouring chunk: the world asks for those rows ahead (World::step).
+// neighbouring chunk: the world asks for those rows ahead
+// (World::add_edge_fetches).
 struct BatchReach {
   std::uint32_t lowest = std::numeric_limits<std::uint32_t>::max(), highest = 0;
   void add(std::uint32_t j) {

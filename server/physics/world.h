@@ -8,8 +8,8 @@
 //   swap           the last pass's pos_next, vel_half_next become pos, vel_half
 //   players move   (serial, few)
 //   rebuild?       if a ball moved > skin/2 and the lists miss one of its
-//                  contacts (or it moved > skin, or many did): sort by cell,
-//                  reorder, new lists
+//                  contacts (or the check cannot reach that far, or many
+//                  balls moved that far): sort by cell, reorder, new lists
 //   step pass    ║ parallel over balls (kernels.h): a = F/m + g, v = v_half + a dt/2,
 //                  then the next half kick and drift into pos_next, vel_half_next
 //
@@ -186,8 +186,9 @@ class World {
   // as many once the fastest ball moved well past the skin), so even at that
   // count a step's checks cost about 1 % of the rebuild they put off.
   static constexpr std::uint32_t kFarBallsPerCheck = 256;
-  // Far balls' checks per thread at least: from 8 checks, two threads
-  // measured faster than one (1-2 % of a settled tank's step).
+  // Far balls' checks per thread at least: a check costs about a hundred
+  // balls' steps, so from 8 checks two threads share them (measured within
+  // this machine's noise: +1.4, -1.5 and +1.5 % of a settled tank's step).
   static constexpr std::uint32_t kFarChecksPerThread = 4;
   static constexpr float kFarMargin = 1.0f - 1e-5f;  // a ball right at skin / 2 counts as far
   // What each thread's chunk of the last step pass reported.
