@@ -37,10 +37,13 @@ struct RowFetch {
 };
 
 struct StepArrays {
-  const Float4* pos;       // x, y, z, radius at this step
-  const Float4* vel_half;  // vx, vy, vz, mass: velocity half a step before
-  Float4* pos_next;        // out: position one step later
-  Float4* vel_half_next;   // out: velocity half a step later
+  const Float4* pos;  // x, y, z, radius at this step
+  // vx, vy, vz, 1 / mass: velocity half a step before. The inverse mass, as
+  // both uses need it: F / m becomes a product, and a pair's effective mass
+  // m1 m2 / (m1 + m2) = 1 / (1/m1 + 1/m2) needs one sum.
+  const Float4* vel_half;
+  Float4* pos_next;       // out: position one step later
+  Float4* vel_half_next;  // out: velocity half a step later
   const Float4* pos_at_build;
   // Full neighbour lists (each pair appears from both sides), as this
   // kernel set's build laid them out (broadphase.h); no count exceeds stride.
@@ -98,7 +101,8 @@ struct Kernels {
 
 // The second half of a step for one ball, in plain C++: the half kick from
 // the full-step velocity v with acceleration a, then the drift from p into
-// vel_half_next and pos_next. Returns the squared distance of pos_next from
+// vel_half_next and pos_next (v's w, which must be 1 / mass, goes with it).
+// Returns the squared distance of pos_next from
 // at_build. The scalar step kernel uses it, and so does the world for balls
 // whose acceleration it computes itself (spawned, or placed in contact).
 inline float kick_drift(const ContactModel& m, const Float4& v, const Float4& p, const Float4& a,

@@ -10,18 +10,19 @@ namespace {
 
 // Spring-dashpot force on a ball along unit normal n (pointing towards the
 // ball): k x - c v_n, with v_n the ball's velocity relative to the other body
-// projected on n, and c from the pair's effective mass.
-inline float normal_force(const ContactModel& m, float overlap, float v_n, float m_eff) {
-  return m.k * overlap - m.damping_factor * std::sqrt(m_eff) * v_n;
+// projected on n, and c from the pair's effective mass, whose inverse is the
+// sum of the two inverse masses (a kinematic body's is 0).
+inline float normal_force(const ContactModel& m, float overlap, float v_n, float inv_m_eff) {
+  return m.k * overlap - m.damping_factor / std::sqrt(inv_m_eff) * v_n;
 }
 
 // Walls are half-spaces: the force keeps growing however deep the ball is.
-inline float wall_force_1d(const ContactModel& m, float pos, float vel, float r, float mass, float lo, float hi) {
+inline float wall_force_1d(const ContactModel& m, float pos, float vel, float r, float inv_mass, float lo, float hi) {
   float f = 0.0f;
   float below = lo + r - pos;
-  if (below > 0.0f) f += normal_force(m, below, vel, mass);
+  if (below > 0.0f) f += normal_force(m, below, vel, inv_mass);
   float above = pos + r - hi;
-  if (above > 0.0f) f -= normal_force(m, above, -vel, mass);
+  if (above > 0.0f) f -= normal_force(m, above, -vel, inv_mass);
   return f;
 }
 
@@ -42,8 +43,7 @@ inline float wall_force_1d(const ContactModel& m, float pos, float vel, float r,
     float inv_dist = 1.0f / dist;
     float nx = dx * inv_dist, ny = dy * inv_dist, nz = dz * inv_dist;
     float v_n = (vi.x - vj.x) * nx + (vi.y - vj.y) * ny + (vi.z - vj.z) * nz;
-    float m_eff = vi.w * vj.w / (vi.w + vj.w);
-    float f = normal_force(m, reach - dist, v_n, m_eff);
+    float f = normal_force(m, reach - dist, v_n, vi.w + vj.w);
     fx += f * nx;
     fy += f * ny;
     fz += f * nz;
@@ -52,7 +52,7 @@ inline float wall_force_1d(const ContactModel& m, float pos, float vel, float r,
 }
 
 // a = F / m + g for ball i, given the sum of its neighbours' forces: adds
-// player spheres and walls.
+// player spheres and walls. vel_half's w is 1 / m, so F / m is a product.
 [[gnu::always_inline]] inline Float4 acceleration(const StepArrays& s, const ContactModel& m, std::uint32_t i,
                                                   const Float4& pair_force) {
   const Float4 pi = s.pos[i];
@@ -79,7 +79,7 @@ inline float wall_force_1d(const ContactModel& m, float pos, float vel, float r,
   fx += wall_force_1d(m, pi.x, vi.x, pi.w, vi.w, m.tank.min.x, m.tank.max.x);
   fy += wall_force_1d(m, pi.y, vi.y, pi.w, vi.w, m.tank.min.y, m.tank.max.y);
   fz += wall_force_1d(m, pi.z, vi.z, pi.w, vi.w, m.tank.min.z, m.tank.max.z);
-  return Float4{fx / vi.w, fy / vi.w - m.gravity, fz / vi.w, 0.0f};
+  return Float4{fx * vi.w, fy * vi.w - m.gravity, fz * vi.w, 0.0f};
 }
 
 Moved step(const StepArrays& arrays, const ContactModel& model, std::uint32_t begin, std::uint32_t end) {

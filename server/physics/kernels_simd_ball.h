@@ -136,7 +136,7 @@ template <class V>
 struct GroupBalls {
   V x, y, z, r;  // position, radius
   V vx, vy, vz;  // half-step velocity
-  V m;           // mass
+  V inv_m;       // 1 / mass
 };
 
 // Sum over each lane's neighbours of the spring-dashpot force, into fx, fy, fz.
@@ -162,15 +162,14 @@ template <class V>
     const V reach = rj + i.r;
     const auto touching = d2 < reach * reach;
     // Velocities for every block: in a pile 99 % of blocks have a lane in contact.
-    V dvx, dvy, dvz, mj;
-    Lanes<V>::load(s.vel_half, block, dvx, dvy, dvz, mj);
+    V dvx, dvy, dvz, inv_mj;
+    Lanes<V>::load(s.vel_half, block, dvx, dvy, dvz, inv_mj);
     dvx -= i.vx, dvy -= i.vy, dvz -= i.vz;
     const V neg_inv_dist = simd::neg_rsqrt(max(d2, tiny));
     const V neg_dist = d2 * neg_inv_dist;
     const V v_n_dist = mul_add(dvz, dz, mul_add(dvy, dy, dvx * dx));  // v_n |d|
-    // sqrt(m_eff) = sqrt(mi mj / (mi + mj)) = mi mj / sqrt(mi mj (mi + mj)): one estimate, no reciprocal.
-    const V mi_mj = i.m * mj;
-    const V c = neg_damping * mi_mj * simd::neg_rsqrt(mi_mj * (i.m + mj));  // damping * sqrt(m_eff)
+    // sqrt(m_eff) = 1 / sqrt(1/mi + 1/mj): the rows carry inverse masses, so one sum and one estimate.
+    const V c = neg_damping * simd::neg_rsqrt(i.inv_m + inv_mj);  // damping * sqrt(m_eff)
     // f / |d| multiplies the unnormalised d: the normal is never formed.
     const V f_over_dist = keep(touching, mul_add(c, v_n_dist * neg_inv_dist, k * (reach + neg_dist)) * neg_inv_dist);
     fx = mul_add(f_over_dist, dx, fx);
@@ -199,7 +198,7 @@ template <class V>
                        (i.y + r > V::splat(t.max.y)) | (V::splat(t.min.z) + r > i.z) | (i.z + r > V::splat(t.max.z));
   if (simd::any(in_wall) || s.players > 0) {  // most groups touch no wall
     const V k = V::splat(m.k);
-    const V c = V::splat(m.damping_factor) * sqrt(i.m);  // walls and players are kinematic: m_eff = m
+    const V c = V::splat(m.damping_factor) / sqrt(i.inv_m);  // walls and players are kinematic: m_eff = m
     fx += wall_force(k, c, i.x, i.vx, r, t.min.x, t.max.x);
     fy += wall_force(k, c, i.y, i.vy, r, t.min.y, t.max.y);
     fz += wall_force(k, c, i.z, i.vz, r, t.min.z, t.max.z);
@@ -220,9 +219,9 @@ template <class V>
       fz = mul_add(f_over_dist, dz, fz);
     }
   }
-  fx = fx / i.m;
-  fy = fy / i.m - V::splat(m.gravity);
-  fz = fz / i.m;
+  fx = fx * i.inv_m;
+  fy = fy * i.inv_m - V::splat(m.gravity);
+  fz = fz * i.inv_m;
 }
 
 constexpr std::size_t kCacheLine = 64;
@@ -304,7 +303,7 @@ template <class V, class PerGroup>
     }
     GroupBalls<V> i;
     Lanes<V>::load(s.pos, at, i.x, i.y, i.z, i.r);
-    Lanes<V>::load(s.vel_half, at, i.vx, i.vy, i.vz, i.m);
+    Lanes<V>::load(s.vel_half, at, i.vx, i.vy, i.vz, i.inv_m);
     V ax, ay, az;
     neighbour_forces(s, m, block, blocks, i, ax, ay, az);
     acceleration(s, m, i, ax, ay, az);
@@ -339,7 +338,7 @@ Moved step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
     const V half_dt = V::splat(m.half_dt), dt = V::splat(m.dt);
     const V vx = mul_add(ax, half_dt, i.vx), vy = mul_add(ay, half_dt, i.vy), vz = mul_add(az, half_dt, i.vz);
     const V hx = mul_add(ax, half_dt, vx), hy = mul_add(ay, half_dt, vy), hz = mul_add(az, half_dt, vz);
-    Lanes<V>::store(hx, hy, hz, i.m, s.vel_half_next, at);
+    Lanes<V>::store(hx, hy, hz, i.inv_m, s.vel_half_next, at);
     const V px = mul_add(hx, dt, i.x), py = mul_add(hy, dt, i.y), pz = mul_add(hz, dt, i.z);
     Lanes<V>::store(px, py, pz, i.r, s.pos_next, at);
     V bx, by, bz, br;

@@ -13,7 +13,11 @@ namespace fishtank {
 namespace {
 
 constexpr float kPackingLimit = 0.6f;
-constexpr Float4 kGhostVel{0.0f, 0.0f, 0.0f, 1.0f};
+constexpr Float4 kGhostVel{0.0f, 0.0f, 0.0f, 1.0f};  // mass 1: the same as vel_ and as a half-step row
+
+// vel_ carries each ball's mass, as observers expect; the kernels' half-step
+// rows carry 1 / mass (StepArrays::vel_half).
+Float4 half_step_row(const Float4& vel) { return {vel.x, vel.y, vel.z, 1.0f / vel.w}; }
 
 class PhaseTimer {
  public:
@@ -285,7 +289,8 @@ void World::add_edge_fetches(StepArrays& s, std::uint32_t begin, std::uint32_t e
 }
 
 float World::kick_drift(std::uint32_t i, const Float4& a) {
-  return fishtank::kick_drift(model_, vel_[i], pos_[i], a, pos_at_build_[i], vel_half_next_[i], pos_next_[i]);
+  return fishtank::kick_drift(model_, half_step_row(vel_[i]), pos_[i], a, pos_at_build_[i], vel_half_next_[i],
+                              pos_next_[i]);
 }
 
 // The last pass read vel_half = v(t - dt/2) and wrote vel_half_next =
@@ -297,7 +302,8 @@ void World::derive_velocities() const {
   if (!vel_stale_) return;
   for (std::uint32_t i = 0; i < n_; ++i) {
     const Float4 before = vel_half_[i], after = vel_half_next_[i];
-    vel_[i] = {0.5f * (before.x + after.x), 0.5f * (before.y + after.y), 0.5f * (before.z + after.z), before.w};
+    const float mass = kBallKinds[kind_[i]].mass;  // the rows carry 1 / mass
+    vel_[i] = {0.5f * (before.x + after.x), 0.5f * (before.y + after.y), 0.5f * (before.z + after.z), mass};
   }
   vel_stale_ = false;
 }
@@ -314,7 +320,7 @@ void World::start_from_current_state() {
   derive_velocities();
   if (needs_rebuild_) rebuild();
   PhaseTimer timer(phase_seconds_.step_pass);
-  std::copy(vel_.begin(), vel_.end(), vel_half_.begin());
+  std::transform(vel_.begin(), vel_.end(), vel_half_.begin(), half_step_row);
   StepArrays s = arrays();
   pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int) {
     kernels_.accelerations(s, model_, acc_.data(), begin, end);

@@ -159,6 +159,7 @@ class World {
 
   std::uint32_t n_ = 0;
   // n_ balls, then kGhostSlots ghosts far away (index n_ pads neighbour lists).
+  // The half-step rows' w is 1 / mass (StepArrays::vel_half), vel_'s the mass.
   AlignedVector<Float4> pos_, vel_half_;
   AlignedVector<Float4> pos_next_, vel_half_next_;  // written by the step pass
   // The full-step velocity at time(): stale after a pass until derived from

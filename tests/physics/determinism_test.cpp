@@ -79,7 +79,7 @@ struct DenseScene {
     for (std::uint32_t i = 0; i < n; ++i) {
       const BallKind& kind = kBallKinds[i % kKindCount];
       unsorted[i] = {at(rng), 6.0f + at(rng), at(rng), 0.5f * kind.diameter};
-      unsorted_vel[i] = {speed(rng), speed(rng), speed(rng), kind.mass};
+      unsorted_vel[i] = {speed(rng), speed(rng), speed(rng), 1.0f / kind.mass};  // a half-step row: 1 / mass
     }
     list.configure(params.tank, params.skin);
     std::vector<std::uint32_t> order;
