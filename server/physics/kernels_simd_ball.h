@@ -261,12 +261,14 @@ template <std::uint32_t kCount>
     prefetch<false>(s.neighbours, lists + line);
 }
 
+inline bool in_window(const RowFetch& f, std::uint32_t batch) { return batch >= f.first_batch && batch < f.end_batch; }
+
 // Asks for this group's share of a RowFetch's cache lines, when `batch` (a
 // batch number) is in its window; `share` is the group's place in its batch.
 template <std::uint32_t kCount>
 [[gnu::always_inline]] inline void fetch_rows(const StepArrays& s, const RowFetch& f, std::uint32_t batch,
                                               std::uint32_t share) {
-  if (batch < f.first_batch || batch >= f.end_batch) return;
+  if (!in_window(f, batch)) return;
   constexpr std::size_t kGroups = kStepBatch / kCount;
   const std::size_t first_line = f.rows_begin * sizeof(Float4) / kCacheLine;
   const std::size_t end_line = (f.rows_end * sizeof(Float4) + kCacheLine - 1) / kCacheLine;
@@ -293,9 +295,13 @@ template <class V, class PerGroup>
   const std::uint32_t* block = s.neighbours + std::size_t(batch) * s.stride;
   const std::uint32_t* group = s.batch_order + batch;
   const std::uint32_t* const groups_end = group + grouped_length(batch_end(batch, end) - batch, kCount);
+  // Decided once per batch: most batches are in no fetch's window (all, on one thread).
+  const std::uint32_t batch_number = batch / kStepBatch;
+  const bool fetching = in_window(s.edge_fetch[0], batch_number) || in_window(s.edge_fetch[1], batch_number);
   for (std::uint32_t share = 0; group < groups_end; group += kCount, ++share) {
     if (s.beyond_cache) prefetch_next_batch<kCount>(s, batch, share);
-    for (const RowFetch& f : s.edge_fetch) fetch_rows<kCount>(s, f, batch / kStepBatch, share);
+    if (fetching)
+      for (const RowFetch& f : s.edge_fetch) fetch_rows<kCount>(s, f, batch_number, share);
     std::uint32_t blocks = 0, at[kCount];
     for (std::uint32_t l = 0; l < kCount; ++l) {
       blocks = std::max(blocks, s.neighbour_count[group[l]]);
