@@ -24,6 +24,8 @@ struct F8 {
 
   static F8 splat(float s) { return {_mm256_set1_ps(s)}; }
   static F8 zero() { return {_mm256_setzero_ps()}; }
+  // Eight floats stored as their bits (32-byte aligned); the intrinsic's load may alias any type.
+  static F8 load_bits(const std::uint32_t* bits) { return {_mm256_load_ps(reinterpret_cast<const float*>(bits))}; }
   // lo in the low half, hi in the high half: two aligned loads.
   static F8 load_pair(const Float4& lo, const Float4& hi) {
     return {_mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(&lo.x)), _mm_load_ps(&hi.x), 1)};

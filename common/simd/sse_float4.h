@@ -26,6 +26,8 @@ struct F4 {
   static F4 zero() { return {_mm_setzero_ps()}; }
   static F4 load(const Float4& f) { return {_mm_load_ps(&f.x)}; }
   static F4 loadu(const float* f) { return {_mm_loadu_ps(f)}; }
+  // Four floats stored as their bits (16-byte aligned); the intrinsic's load may alias any type.
+  static F4 load_bits(const std::uint32_t* bits) { return {_mm_load_ps(reinterpret_cast<const float*>(bits))}; }
   void store(Float4& f) const { _mm_store_ps(&f.x, v); }
 };
 

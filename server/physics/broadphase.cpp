@@ -64,6 +64,10 @@ void NeighbourList::reserve(std::uint32_t n, std::uint32_t stride, std::uint32_t
   counts_.resize(n);
   batch_order_.resize(std::size_t(n) + lanes - 1);
   reach_.resize((std::size_t(n) + kStepBatch - 1) / kStepBatch);
+  if (lanes > 1) {
+    group_records_.resize(4 * (std::size_t(n) + lanes - 1));
+    group_blocks_.resize((std::size_t(n) + lanes - 1) / lanes);
+  }
 }
 
 ListBuild NeighbourList::grid_view() const {
@@ -125,6 +129,7 @@ ListBuild NeighbourList::build_view(const Float4* pos, std::uint32_t n) {
   b.neighbours = neighbours_.get(), b.counts = counts_.data(), b.stride = stride_;
   b.batch_order = batch_order_.data();
   b.reach = reach_.data();
+  b.group_records = group_records_.data(), b.group_blocks = group_blocks_.data();
   return b;
 }
 

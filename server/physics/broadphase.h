@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <type_traits>
@@ -49,6 +50,15 @@ namespace fishtank {
 // balls of similar counts (kernels_simd_ball.h). stride bounds a list's
 // length: it sizes the room, not the layout, so a batch's lists fill one
 // stretch of memory as long as they are, however large the stride.
+//
+// The SIMD builds also write, per group, what the step needs of the group
+// itself, so that it reads aligned vectors instead of gathering rows into
+// lanes: a record of 32-bit words at group_records + 4 * (the group's place
+// in batch_order), four words per ball, holding the balls' positions at the
+// build axis by axis (the bits of x of every lane, then y, then z) and then
+// their list entries (write_group_record); and its number of blocks at
+// group_blocks + place / lanes. The scalar twin reads the rows and counts
+// instead.
 constexpr std::uint32_t kStepBatch = 128;
 
 // The end of the batch that holds ball `first`, within [.., end).
@@ -70,6 +80,18 @@ inline Row& listed(Row* rows, std::uint32_t entry) {
 // last group of a short batch repeats its last ball).
 inline std::uint32_t grouped_length(std::uint32_t count, std::uint32_t lanes) {
   return (count + lanes - 1) / lanes * lanes;
+}
+
+// The record of the group of `lanes` balls group[0..lanes) (see above).
+inline void write_group_record(const Float4* pos, const std::uint32_t* group, std::uint32_t lanes,
+                               std::uint32_t* record) {
+  for (std::uint32_t l = 0; l < lanes; ++l) {
+    const Float4& p = pos[group[l]];
+    std::memcpy(record + l, &p.x, sizeof p.x);
+    std::memcpy(record + lanes + l, &p.y, sizeof p.y);
+    std::memcpy(record + 2 * lanes + l, &p.z, sizeof p.z);
+    record[3 * lanes + l] = list_entry(group[l]);
+  }
 }
 
 // The balls a batch's lists name lie in [lowest, highest] (lowest > highest
@@ -102,12 +124,14 @@ struct ListBuild {
   int block;                        // cells per block in x
   Vec3 origin, edge;                // the grid's lowest corner, and its cells' size
   float skin;
-  const float *x, *y, *z, *r;  // the same balls axis by axis, with the ghosts (for lanes > 1 only)
-  std::uint32_t* neighbours;   // out: the lists, laid out as above
-  std::uint32_t* counts;       // out: the true count, which may exceed stride
-  std::uint32_t stride;        // the most entries a list may store
-  std::uint32_t* batch_order;  // out: per batch, its balls in groups (room for lanes - 1 more at the end)
-  BatchReach* reach;           // out, threaded builds only: per batch, the balls its stored lists name
+  const float *x, *y, *z, *r;    // the same balls axis by axis, with the ghosts (for lanes > 1 only)
+  std::uint32_t* neighbours;     // out: the lists, laid out as above
+  std::uint32_t* counts;         // out: the true count, which may exceed stride
+  std::uint32_t stride;          // the most entries a list may store
+  std::uint32_t* batch_order;    // out: per batch, its balls in groups (room for lanes - 1 more at the end)
+  BatchReach* reach;             // out, threaded builds only: per batch, the balls its stored lists name
+  std::uint32_t* group_records;  // out, SIMD builds only: per group, its record (see above)
+  std::uint32_t* group_blocks;   // out, SIMD builds only: per group, its number of blocks
 };
 
 // One ball's stored list: neighbour k is listed_index(first[k * lanes]).
@@ -227,6 +251,8 @@ class NeighbourList {
   const std::uint32_t* counts() const { return counts_.data(); }
   const std::uint32_t* batch_order() const { return batch_order_.data(); }
   const BatchReach* batch_reach() const { return reach_.data(); }
+  const std::uint32_t* group_records() const { return group_records_.data(); }
+  const std::uint32_t* group_blocks() const { return group_blocks_.data(); }
 
   // Calls visit(i, ListView) once for each ball of the last build, batch by
   // batch in the layout's order.
@@ -258,7 +284,9 @@ class NeighbourList {
   std::vector<std::uint32_t> counts_;
   std::vector<std::uint32_t> batch_order_;
   std::vector<BatchReach> reach_;
-  AlignedVector<float> axes_;  // x, y, z, radius of the sorted balls, axis by axis (ListBuild)
+  AlignedVector<std::uint32_t> group_records_;  // SIMD builds only
+  std::vector<std::uint32_t> group_blocks_;     // SIMD builds only
+  AlignedVector<float> axes_;                   // x, y, z, radius of the sorted balls, axis by axis (ListBuild)
 };
 
 template <class Visit>

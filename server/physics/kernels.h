@@ -51,8 +51,13 @@ struct StepArrays {
   const std::uint32_t* neighbour_count;
   std::uint32_t stride;
   const std::uint32_t* batch_order;  // ListBuild::batch_order
-  const Float4* player_pos;          // x, y, z, radius
-  const Float4* player_vel;          // vx, vy, vz, 0
+  // The SIMD builds' per-group records and block counts (broadphase.h): the
+  // SIMD steps read these instead of batch_order, the counts and
+  // pos_at_build; the scalar twin, which has no groups, reads those.
+  const std::uint32_t* group_records;
+  const std::uint32_t* group_blocks;
+  const Float4* player_pos;  // x, y, z, radius
+  const Float4* player_vel;  // vx, vy, vz, 0
   int players;
   // Whether the arrays outgrow the caches, so that the SIMD kernels ask for
   // each batch's rows ahead (kernels_simd_ball.h, prefetch_next_batch).

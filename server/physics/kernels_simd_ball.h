@@ -119,6 +119,9 @@ std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t
       }
       for (std::uint32_t n = 0; n < blocks; ++n, block += kLanes)
         for (std::uint32_t l = 0; l < kLanes; ++l) block[l] = list_entry(n < count[l] ? row[l][n] : b.n);
+      const std::size_t place = group - b.batch_order;
+      write_group_record(b.pos, group, kLanes, b.group_records + 4 * place);
+      b.group_blocks[place / kLanes] = blocks;
     }
   }
   return longest;
@@ -251,7 +254,7 @@ template <std::uint32_t kCount>
   for (std::size_t line = rows; line < rows + kCount * sizeof(Float4); line += kCacheLine) {
     prefetch<false>(s.pos, line);
     prefetch<false>(s.vel_half, line);
-    prefetch<false>(s.pos_at_build, line);
+    prefetch<false>(s.group_records, line);  // 16 bytes per ball too, in the batch's group order
     prefetch<true>(s.pos_next, line);
     prefetch<true>(s.vel_half_next, line);
   }
@@ -284,36 +287,35 @@ template <std::uint32_t kCount>
 // Each pass takes a batch's groups (kStepBatch, broadphase.h), one ball per
 // lane: the neighbour sums from the group's blocks, walls and players give
 // a = F / m + g for the group's balls at once, and per_group(at, i, ax, ay,
-// az) does the rest (the step: kick and drift) and scatters the results back
-// to their rows at list entries `at`. A padded group repeats a ball: it is
-// computed twice and stored twice, with the same result.
+// az, record) does the rest (the step: kick and drift) and scatters the
+// results back to their rows at list entries `at`; record is the group's
+// (broadphase.h). A padded group repeats a ball: it is computed twice and
+// stored twice, with the same result.
 template <class V, class PerGroup>
 [[gnu::always_inline]] inline void for_each_group_of_batch(const StepArrays& s, const ContactModel& m,
                                                            std::uint32_t batch, std::uint32_t end,
                                                            PerGroup& per_group) {
   constexpr std::uint32_t kCount = Lanes<V>::kCount;
   const std::uint32_t* block = s.neighbours + std::size_t(batch) * s.stride;
-  const std::uint32_t* group = s.batch_order + batch;
-  const std::uint32_t* const groups_end = group + grouped_length(batch_end(batch, end) - batch, kCount);
+  const std::uint32_t groups = grouped_length(batch_end(batch, end) - batch, kCount) / kCount;
+  const std::uint32_t* const group_blocks = s.group_blocks + batch / kCount;
+  const std::uint32_t* record = s.group_records + 4 * std::size_t(batch);
   // Decided once per batch: most batches are in no fetch's window (all, on one thread).
   const std::uint32_t batch_number = batch / kStepBatch;
   const bool fetching = in_window(s.edge_fetch[0], batch_number) || in_window(s.edge_fetch[1], batch_number);
-  for (std::uint32_t share = 0; group < groups_end; group += kCount, ++share) {
+  for (std::uint32_t share = 0; share < groups; ++share, record += 4 * kCount) {
     if (s.beyond_cache) prefetch_next_batch<kCount>(s, batch, share);
     if (fetching)
       for (const RowFetch& f : s.edge_fetch) fetch_rows<kCount>(s, f, batch_number, share);
-    std::uint32_t blocks = 0, at[kCount];
-    for (std::uint32_t l = 0; l < kCount; ++l) {
-      blocks = std::max(blocks, s.neighbour_count[group[l]]);
-      at[l] = list_entry(group[l]);
-    }
+    const std::uint32_t blocks = group_blocks[share];
+    const std::uint32_t* const at = record + 3 * kCount;  // the group's list entries
     GroupBalls<V> i;
     Lanes<V>::load(s.pos, at, i.x, i.y, i.z, i.r);
     Lanes<V>::load(s.vel_half, at, i.vx, i.vy, i.vz, i.inv_m);
     V ax, ay, az;
     neighbour_forces(s, m, block, blocks, i, ax, ay, az);
     acceleration(s, m, i, ax, ay, az);
-    per_group(at, i, ax, ay, az);
+    per_group(at, i, ax, ay, az, record);
     block += std::size_t(blocks) * kCount;
   }
 }
@@ -340,32 +342,36 @@ Moved step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
   const V far_d2 = V::splat(s.far_d2);
   std::uint32_t* const far_balls = s.far_balls + begin;
   std::uint32_t far = 0;
-  for_each_group<V>(s, m, begin, end, [&](const std::uint32_t* at, const GroupBalls<V>& i, V ax, V ay, V az) {
-    const V half_dt = V::splat(m.half_dt), dt = V::splat(m.dt);
-    const V vx = mul_add(ax, half_dt, i.vx), vy = mul_add(ay, half_dt, i.vy), vz = mul_add(az, half_dt, i.vz);
-    const V hx = mul_add(ax, half_dt, vx), hy = mul_add(ay, half_dt, vy), hz = mul_add(az, half_dt, vz);
-    Lanes<V>::store(hx, hy, hz, i.inv_m, s.vel_half_next, at);
-    const V px = mul_add(hx, dt, i.x), py = mul_add(hy, dt, i.y), pz = mul_add(hz, dt, i.z);
-    Lanes<V>::store(px, py, pz, i.r, s.pos_next, at);
-    V bx, by, bz, br;
-    Lanes<V>::load(s.pos_at_build, at, bx, by, bz, br);
-    bx -= px, by -= py, bz -= pz;
-    const V d2 = mul_add(bz, bz, mul_add(by, by, bx * bx));
-    max_d2 = max(max_d2, d2);
-    if (int lanes = simd::bits(d2 > far_d2)) [[unlikely]] {
-      // A padded group repeats its last ball in the lanes after it: list it once.
-      for (std::uint32_t l = 0; l < Lanes<V>::kCount; ++l, lanes >>= 1)
-        if ((lanes & 1) && (l == 0 || at[l] != at[l - 1])) far_balls[far++] = listed_index(at[l]);
-    }
-  });
+  for_each_group<V>(
+      s, m, begin, end,
+      [&](const std::uint32_t* at, const GroupBalls<V>& i, V ax, V ay, V az, const std::uint32_t* record) {
+        const V half_dt = V::splat(m.half_dt), dt = V::splat(m.dt);
+        const V vx = mul_add(ax, half_dt, i.vx), vy = mul_add(ay, half_dt, i.vy), vz = mul_add(az, half_dt, i.vz);
+        const V hx = mul_add(ax, half_dt, vx), hy = mul_add(ay, half_dt, vy), hz = mul_add(az, half_dt, vz);
+        Lanes<V>::store(hx, hy, hz, i.inv_m, s.vel_half_next, at);
+        const V px = mul_add(hx, dt, i.x), py = mul_add(hy, dt, i.y), pz = mul_add(hz, dt, i.z);
+        Lanes<V>::store(px, py, pz, i.r, s.pos_next, at);
+        // Where the lanes' balls were at the build: the record's first three vectors.
+        constexpr std::uint32_t kCount = Lanes<V>::kCount;
+        V bx = V::load_bits(record), by = V::load_bits(record + kCount), bz = V::load_bits(record + 2 * kCount);
+        bx -= px, by -= py, bz -= pz;
+        const V d2 = mul_add(bz, bz, mul_add(by, by, bx * bx));
+        max_d2 = max(max_d2, d2);
+        if (int lanes = simd::bits(d2 > far_d2)) [[unlikely]] {
+          // A padded group repeats its last ball in the lanes after it: list it once.
+          for (std::uint32_t l = 0; l < Lanes<V>::kCount; ++l, lanes >>= 1)
+            if ((lanes & 1) && (l == 0 || at[l] != at[l - 1])) far_balls[far++] = listed_index(at[l]);
+        }
+      });
   return Moved{Lanes<V>::largest(max_d2), far};
 }
 
 template <class V>
 void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin, std::uint32_t end) {
-  for_each_group<V>(s, m, begin, end, [&](const std::uint32_t* at, const GroupBalls<V>&, V ax, V ay, V az) {
-    Lanes<V>::store(ax, ay, az, V::zero(), acc, at);
-  });
+  for_each_group<V>(s, m, begin, end,
+                    [&](const std::uint32_t* at, const GroupBalls<V>&, V ax, V ay, V az, const std::uint32_t*) {
+                      Lanes<V>::store(ax, ay, az, V::zero(), acc, at);
+                    });
 }
 
 }  // namespace

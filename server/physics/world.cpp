@@ -231,6 +231,8 @@ StepArrays World::arrays() {
                     list_.counts(),
                     list_.stride(),
                     list_.batch_order(),
+                    list_.group_records(),
+                    list_.group_blocks(),
                     player_pos_.data(),
                     player_vel_.data(),
                     static_cast<int>(player_pos_.size()),

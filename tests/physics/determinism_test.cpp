@@ -60,6 +60,11 @@ TEST_CASE("the AVX2 level's state is bit-identical for 1, 2 and 3 threads", "[ph
 
 namespace {
 
+// Where a step finds the lists (broadphase.h's layout).
+struct LayoutView {
+  const std::uint32_t *neighbours, *batch_order, *group_records, *group_blocks;
+};
+
 // n densely packed random balls of every kind (many in contact), in cell
 // order, with their lists as a kernel set builds them.
 struct DenseScene {
@@ -94,15 +99,25 @@ struct DenseScene {
   }
 
   // One step by the kernel, called on the given consecutive ranges of balls,
-  // with the lists laid out in `neighbours` and `batch_order`; returns every
-  // output value's bits.
+  // with the lists laid out as `layout` says; returns every output value's bits.
   std::vector<std::uint32_t> step_bits(const Kernels& kernels, const std::vector<std::uint32_t>& bounds,
-                                       const std::uint32_t* neighbours, const std::uint32_t* batch_order) const {
+                                       const LayoutView& layout) const {
     AlignedVector<Float4> pos_next(n), vel_half_next(n);
     const StepArrays s{
-        pos.data(),  vel_half.data(), pos_next.data(), vel_half_next.data(),
-        pos.data(),  neighbours,      list.counts(),   list.stride(),
-        batch_order, nullptr,         nullptr,         0,
+        pos.data(),
+        vel_half.data(),
+        pos_next.data(),
+        vel_half_next.data(),
+        pos.data(),
+        layout.neighbours,
+        list.counts(),
+        list.stride(),
+        layout.batch_order,
+        layout.group_records,
+        layout.group_blocks,
+        nullptr,
+        nullptr,
+        0,
     };
     for (std::size_t r = 0; r + 1 < bounds.size(); ++r) kernels.step(s, model, bounds[r], bounds[r + 1]);
     std::vector<std::uint32_t> bits;
@@ -122,6 +137,9 @@ struct DenseScene {
 // balls than in the build's grouping by count.
 struct Layout {
   std::vector<std::uint32_t> neighbours, batch_order;
+  AlignedVector<std::uint32_t> group_records;
+  std::vector<std::uint32_t> group_blocks;
+  LayoutView view() const { return {neighbours.data(), batch_order.data(), group_records.data(), group_blocks.data()}; }
 };
 
 Layout shuffled_groups(const DenseScene& scene, std::uint32_t lanes) {
@@ -133,6 +151,8 @@ Layout shuffled_groups(const DenseScene& scene, std::uint32_t lanes) {
   Layout out;
   out.neighbours.assign((std::size_t(n) + lanes - 1) * scene.list.stride(), 0);
   out.batch_order.assign(std::size_t(n) + lanes - 1, 0);
+  out.group_records.assign(4 * (std::size_t(n) + lanes - 1), 0);
+  out.group_blocks.assign((std::size_t(n) + lanes - 1) / lanes, 0);
   std::mt19937 rng(3);
   for (std::uint32_t batch = 0; batch < n; batch += kStepBatch) {
     const std::uint32_t balls = batch_end(batch, n) - batch, grouped = grouped_length(balls, lanes);
@@ -144,6 +164,8 @@ Layout shuffled_groups(const DenseScene& scene, std::uint32_t lanes) {
     for (std::uint32_t g = 0; g < grouped; g += lanes) {
       std::size_t blocks = 0;
       for (std::uint32_t l = 0; l < lanes; ++l) blocks = std::max(blocks, lists[order[g + l]].size());
+      write_group_record(scene.pos.data(), order + g, lanes, out.group_records.data() + 4 * (std::size_t(batch) + g));
+      out.group_blocks[(batch + g) / lanes] = static_cast<std::uint32_t>(blocks);
       for (std::size_t b = 0; b < blocks; ++b)
         for (std::uint32_t l = 0; l < lanes; ++l) {
           const std::vector<std::uint32_t>& list = lists[order[g + l]];
@@ -165,11 +187,11 @@ TEST_CASE("a ball's step does not depend on which balls share its vector", "[phy
   for (const Kernels* kernels : simd) {
     INFO(kernels->variant);
     const DenseScene scene(*kernels, 300);
-    const std::vector<std::uint32_t> built =
-        scene.step_bits(*kernels, {0, 300}, scene.list.neighbours(), scene.list.batch_order());
-    CHECK(scene.step_bits(*kernels, {0, kStepBatch, 2 * kStepBatch, 300}, scene.list.neighbours(),
-                          scene.list.batch_order()) == built);
+    const LayoutView as_built{scene.list.neighbours(), scene.list.batch_order(), scene.list.group_records(),
+                              scene.list.group_blocks()};
+    const std::vector<std::uint32_t> built = scene.step_bits(*kernels, {0, 300}, as_built);
+    CHECK(scene.step_bits(*kernels, {0, kStepBatch, 2 * kStepBatch, 300}, as_built) == built);
     const Layout shuffled = shuffled_groups(scene, kernels->list_lanes);
-    CHECK(scene.step_bits(*kernels, {0, 300}, shuffled.neighbours.data(), shuffled.batch_order.data()) == built);
+    CHECK(scene.step_bits(*kernels, {0, 300}, shuffled.view()) == built);
   }
 }

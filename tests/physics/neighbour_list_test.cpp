@@ -1,10 +1,11 @@
 // Every list-build kernel finds exactly the pairs within r_i + r_j + skin, in
 // the same order, however many of the neighbouring cells a ball's reach lets
-// it skip, reports lists that do not fit instead of overrunning, and says
-// which balls each batch's lists reach.
+// it skip, reports lists that do not fit instead of overrunning, says which
+// balls each batch's lists reach, and gives each SIMD group its record.
 
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <cstring>
 #include <random>
 
 #include "tests/physics/scenarios.h"
@@ -67,6 +68,29 @@ Lists build(const Kernels& kernels, const TankBounds& tank, const AlignedVector<
     INFO("batch " << batch);
     REQUIRE(list.batch_reach()[batch].lowest == expected.lowest);
     REQUIRE(list.batch_reach()[batch].highest == expected.highest);
+  }
+  // Each group's record (SIMD builds) holds its balls' positions at the build
+  // and their list entries, lane by lane, and its block count is its longest
+  // stored list.
+  const std::uint32_t lanes = kernels.list_lanes;
+  for (std::uint32_t batch = 0; lanes > 1 && batch < n; batch += kStepBatch) {
+    const std::uint32_t grouped = grouped_length(batch_end(batch, n) - batch, lanes);
+    for (std::uint32_t place = batch; place < batch + grouped; place += lanes) {
+      const std::uint32_t* record = list.group_records() + 4 * std::size_t(place);
+      std::uint32_t longest = 0;
+      for (std::uint32_t l = 0; l < lanes; ++l) {
+        const std::uint32_t ball = list.batch_order()[place + l];
+        float x, y, z;
+        std::memcpy(&x, record + l, sizeof x);
+        std::memcpy(&y, record + lanes + l, sizeof y);
+        std::memcpy(&z, record + 2 * lanes + l, sizeof z);
+        INFO("group at " << place << ", lane " << l);
+        REQUIRE((x == pos[ball].x && y == pos[ball].y && z == pos[ball].z));
+        REQUIRE(record[3 * lanes + l] == list_entry(ball));
+        longest = std::max(longest, std::min(out.counts[ball], stride));
+      }
+      REQUIRE(list.group_blocks()[place / lanes] == longest);
+    }
   }
   return out;
 }
