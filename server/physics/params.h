@@ -18,7 +18,7 @@ struct PhysicsParams {
   float restitution = 0.6f;        // e, measured rebound / approach normal speed
   int steps_per_contact = 20;      // n in dt = t_c / n
   float dt = 0.0f;                 // 0: derive from k; otherwise must be <= t_c / kMinStepsPerContact
-  float skin = 0.2f;               // neighbour-list skin, units (measured best of 0.1-0.3)
+  float skin = 0.2f;               // neighbour-list skin, units (report, section 3: how it was chosen)
   float gravity = 9.81f;           // m/s^2, along -y
   float player_max_speed = 10.0f;  // m/s; faster commands are clamped
   TankBounds tank;
