@@ -50,10 +50,9 @@ struct StepArrays {
   const std::uint32_t* neighbours;
   const std::uint32_t* neighbour_count;
   std::uint32_t stride;
-  const std::uint32_t* batch_order;  // ListBuild::batch_order
   // The SIMD builds' per-group records and block counts (broadphase.h): the
-  // SIMD steps read these instead of batch_order, the counts and
-  // pos_at_build; the scalar twin, which has no groups, reads those.
+  // SIMD steps read these instead of the counts and pos_at_build; the scalar
+  // twin, which has no groups, reads those.
   const std::uint32_t* group_records;
   const std::uint32_t* group_blocks;
   const Float4* player_pos;  // x, y, z, radius

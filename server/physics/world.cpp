@@ -230,7 +230,6 @@ StepArrays World::arrays() {
                     list_.neighbours(),
                     list_.counts(),
                     list_.stride(),
-                    list_.batch_order(),
                     list_.group_records(),
                     list_.group_blocks(),
                     player_pos_.data(),

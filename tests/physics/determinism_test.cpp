@@ -62,7 +62,7 @@ namespace {
 
 // Where a step finds the lists (broadphase.h's layout).
 struct LayoutView {
-  const std::uint32_t *neighbours, *batch_order, *group_records, *group_blocks;
+  const std::uint32_t *neighbours, *group_records, *group_blocks;
 };
 
 // n densely packed random balls of every kind (many in contact), in cell
@@ -112,7 +112,6 @@ struct DenseScene {
         layout.neighbours,
         list.counts(),
         list.stride(),
-        layout.batch_order,
         layout.group_records,
         layout.group_blocks,
         nullptr,
@@ -136,10 +135,10 @@ struct DenseScene {
 // shuffled before grouping, so that every ball shares its vector with other
 // balls than in the build's grouping by count.
 struct Layout {
-  std::vector<std::uint32_t> neighbours, batch_order;
+  std::vector<std::uint32_t> neighbours;
   AlignedVector<std::uint32_t> group_records;
   std::vector<std::uint32_t> group_blocks;
-  LayoutView view() const { return {neighbours.data(), batch_order.data(), group_records.data(), group_blocks.data()}; }
+  LayoutView view() const { return {neighbours.data(), group_records.data(), group_blocks.data()}; }
 };
 
 Layout shuffled_groups(const DenseScene& scene, std::uint32_t lanes) {
@@ -150,13 +149,13 @@ Layout shuffled_groups(const DenseScene& scene, std::uint32_t lanes) {
   });
   Layout out;
   out.neighbours.assign((std::size_t(n) + lanes - 1) * scene.list.stride(), 0);
-  out.batch_order.assign(std::size_t(n) + lanes - 1, 0);
+  std::vector<std::uint32_t> batch_order(std::size_t(n) + lanes - 1);
   out.group_records.assign(4 * (std::size_t(n) + lanes - 1), 0);
   out.group_blocks.assign((std::size_t(n) + lanes - 1) / lanes, 0);
   std::mt19937 rng(3);
   for (std::uint32_t batch = 0; batch < n; batch += kStepBatch) {
     const std::uint32_t balls = batch_end(batch, n) - batch, grouped = grouped_length(balls, lanes);
-    std::uint32_t* order = out.batch_order.data() + batch;
+    std::uint32_t* order = batch_order.data() + batch;
     std::iota(order, order + balls, batch);
     std::shuffle(order, order + balls, rng);
     for (std::uint32_t k = balls; k < grouped; ++k) order[k] = order[k - 1];
@@ -187,8 +186,7 @@ TEST_CASE("a ball's step does not depend on which balls share its vector", "[phy
   for (const Kernels* kernels : simd) {
     INFO(kernels->variant);
     const DenseScene scene(*kernels, 300);
-    const LayoutView as_built{scene.list.neighbours(), scene.list.batch_order(), scene.list.group_records(),
-                              scene.list.group_blocks()};
+    const LayoutView as_built{scene.list.neighbours(), scene.list.group_records(), scene.list.group_blocks()};
     const std::vector<std::uint32_t> built = scene.step_bits(*kernels, {0, 300}, as_built);
     CHECK(scene.step_bits(*kernels, {0, kStepBatch, 2 * kStepBatch, 300}, as_built) == built);
     const Layout shuffled = shuffled_groups(scene, kernels->list_lanes);
