@@ -39,7 +39,8 @@ inline F4& operator+=(F4& a, F4 b) { return a = a + b; }
 inline F4& operator-=(F4& a, F4 b) { return a = a - b; }
 inline F4 sqrt(F4 a) { return {_mm_sqrt_ps(a.v)}; }
 // -1/sqrt(a) to about 1e-7 relative: the 12-bit hardware estimate plus one
-// Newton step. Cheaper than sqrt and divide, which share one slow unit.
+// Newton step. Where a loop already divides once (the neighbour forces), a
+// second sqrt and divide measured slower: the two share one unit.
 // Negated because SSE's two-operand subtract can then take the constant from
 // memory (h - 1.5) instead of rebuilding it in a register for 1.5 - h on every
 // call; the negation is exact.

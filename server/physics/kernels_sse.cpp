@@ -6,10 +6,10 @@
 // adds each ball's forces in list order as the scalar twin does, and serves
 // four balls per instruction in walls, kick and drift; grouped by neighbour
 // count, its blocks are as full (1.92 blocks of four per ball on the settled
-// tank, against 2.21: technical report, section 4). 1/|d| and sqrt(m_eff) come
-// from the reciprocal-square-root estimate plus a Newton step (1e-7 relative)
-// instead of sqrt and divide; the scalar twin computes them exactly, so the
-// twins agree to float rounding, not bit for bit.
+// tank, against 2.21: technical report, section 4). 1/|d| comes from the
+// reciprocal-square-root estimate plus a Newton step (1e-7 relative) instead
+// of sqrt and divide, which the scalar twin uses, so the twins agree to float
+// rounding, not bit for bit.
 
 #include "server/physics/kernels_simd_ball.h"
 
