@@ -52,8 +52,9 @@ SettleReport settle(World& world, const SceneSpec& spec) {
   const double limit = spec.max_settle_seconds > 0.0 ? spec.max_settle_seconds : (spec.name == "wide" ? 4.0 : 90.0);
   const auto start = std::chrono::steady_clock::now();
   const std::uint64_t first_step = world.steps();
+  // Checked every tenth of a simulated second, reported every tenth check.
+  constexpr std::uint64_t kChecksPerReport = 10;
   const auto check_every = static_cast<std::uint64_t>(std::max(1.0, 0.1 / world.dt()));
-  const auto report_every = static_cast<std::uint64_t>(std::max(1.0, 1.0 / world.dt()));
   SettleReport report;
   for (;;) {
     world.step();
@@ -61,7 +62,7 @@ SettleReport settle(World& world, const SceneSpec& spec) {
     if (done % check_every != 0) continue;
     const double sim = done * double(world.dt());
     const double energy = world.ball_count() ? world.kinetic_energy() / world.ball_count() : 0.0;
-    if (done % report_every == 0)
+    if (done / check_every % kChecksPerReport == 0)
       std::fprintf(stderr, "settling: %.0f s simulated, %u balls in, %u queued, kinetic energy %.4f J/ball\n", sim,
                    world.ball_count(), world.pending(), energy);
     report.settled = world.pending() == 0 && energy < kRestEnergy;
