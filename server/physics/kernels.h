@@ -59,7 +59,7 @@ struct StepArrays {
   const Float4* player_vel;  // vx, vy, vz, 0
   int players;
   // Whether the arrays outgrow the caches, so that the SIMD kernels ask for
-  // each batch's rows ahead (kernels_simd_ball.h, prefetch_next_batch).
+  // rows a few batches ahead (kernels_simd_ball.h, prefetch_batch_ahead).
   bool beyond_cache = false;
   // A ball whose pos_next is further than sqrt(far_d2) from pos_at_build is
   // "far": the step of chunk [begin, end) lists its far balls, each once, at

@@ -244,15 +244,20 @@ inline void prefetch(const void* base, std::size_t bytes) {
 // Beyond the caches (the wide scene from 100 000 balls) a batch's rows arrive
 // late if left to the hardware, which sees them gathered and scattered in the
 // order of the groups, not of the addresses. So each group asks for its share
-// of the next batch's rows, and of the next batch's lists, one batch ahead:
-// share is the group's place in its batch. At 1 000 000 balls this took the
-// step pass from 28.7 to 23.7 ns per ball-step; from cache it changes nothing
-// measurable, and it costs 3 % more instructions, so the world asks for it
-// only for piles larger than the caches (StepArrays::beyond_cache; technical
-// report, 6.2).
+// of the rows and lists of the batch kPrefetchBatches ahead: share is the
+// group's place in its batch. At 1 000 000 balls asking one batch ahead took
+// the step pass from 28.7 to 23.7 ns per ball-step, and four ahead (~60 KB of
+// rows and lists, a few microseconds of work) from 16.0-18.6 to 11.3-12.1
+// against one: one batch's ~2 us did not cover the memory's latency under two
+// threads' misses. From cache it changes nothing measurable, and it costs 3 %
+// more instructions, so the world asks for it only for piles larger than the
+// caches (StepArrays::beyond_cache; technical report, 6.2).
+constexpr std::uint32_t kPrefetchBatches = 4;
+
 template <std::uint32_t kCount>
-[[gnu::always_inline]] inline void prefetch_next_batch(const StepArrays& s, std::uint32_t batch, std::uint32_t share) {
-  const std::size_t rows = (std::size_t(batch) + kStepBatch + share * kCount) * sizeof(Float4);
+[[gnu::always_inline]] inline void prefetch_batch_ahead(const StepArrays& s, std::uint32_t batch, std::uint32_t share) {
+  const std::size_t ahead = std::size_t(batch) + kPrefetchBatches * kStepBatch;
+  const std::size_t rows = (ahead + share * kCount) * sizeof(Float4);
   for (std::size_t line = rows; line < rows + kCount * sizeof(Float4); line += kCacheLine) {
     prefetch<false>(s.pos, line);
     prefetch<false>(s.vel_half, line);
@@ -261,7 +266,7 @@ template <std::uint32_t kCount>
     prefetch<true>(s.vel_half_next, line);
   }
   // A group's blocks take about eight entries (32 bytes) per lane.
-  const std::size_t lists = (std::size_t(batch) + kStepBatch) * s.stride * sizeof(std::uint32_t);
+  const std::size_t lists = ahead * s.stride * sizeof(std::uint32_t);
   for (std::size_t line = share * kCount * 32; line < (share + 1) * kCount * 32; line += kCacheLine)
     prefetch<false>(s.neighbours, lists + line);
 }
@@ -306,7 +311,7 @@ template <class V, class PerGroup>
   const std::uint32_t batch_number = batch / kStepBatch;
   const bool fetching = in_window(s.edge_fetch[0], batch_number) || in_window(s.edge_fetch[1], batch_number);
   for (std::uint32_t share = 0; share < groups; ++share, record += 4 * kCount) {
-    if (s.beyond_cache) prefetch_next_batch<kCount>(s, batch, share);
+    if (s.beyond_cache) prefetch_batch_ahead<kCount>(s, batch, share);
     if (fetching)
       for (const RowFetch& f : s.edge_fetch) fetch_rows<kCount>(s, f, batch_number, share);
     const std::uint32_t blocks = group_blocks[share];
