@@ -124,8 +124,9 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
     return fail("--settle-time must be between 0 and 1e6 simulated seconds");
   if (!is_known_scene(o.bench_spec.scene.name))
     return fail("unknown scene '" + o.bench_spec.scene.name + "'; the scenes are tank and wide");
-  if (steps_per_contact < 1 || steps_per_contact > 100000)
-    return fail("--steps-per-contact must be between 10 and 100000, got " + std::to_string(steps_per_contact));
+  if (steps_per_contact < PhysicsParams::kMinStepsPerContact || steps_per_contact > 100000)
+    return fail("--steps-per-contact must be between " + std::to_string(PhysicsParams::kMinStepsPerContact) +
+                " and 100000, got " + std::to_string(steps_per_contact));
 
   if (port < 0 || port > 65535) return fail("--port must be between 0 and 65535, got " + std::to_string(port));
   if (!std::isfinite(o.snapshot_rate) || o.snapshot_rate < 1.0 || o.snapshot_rate > 1000.0)

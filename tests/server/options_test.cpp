@@ -1,0 +1,142 @@
+// fishtank-server's command line: every bad value is refused with a message
+// that names the flag and a non-zero exit code, before anything starts;
+// --help lists every flag; good values land where the server reads them.
+
+#include "server/options.h"
+
+#include <catch2/catch.hpp>
+#include <string>
+#include <vector>
+
+#include "server/physics/worker_pool.h"
+
+using namespace fishtank;
+
+namespace {
+
+ParseResult parse(std::vector<std::string> args, const char* variant = "sse", bool threaded = true) {
+  args.insert(args.begin(), "fishtank-server");
+  std::vector<const char*> argv;
+  for (const std::string& a : args) argv.push_back(a.c_str());
+  return parse_server_options(static_cast<int>(argv.size()), argv.data(), variant, threaded);
+}
+
+}  // namespace
+
+TEST_CASE("no flags: the paced server with 1000 balls on every core and the default physics", "[options]") {
+  const ParseResult r = parse({});
+  REQUIRE(r.options);
+  CHECK(r.exit_code == 0);
+  CHECK_FALSE(r.options->bench);
+  CHECK(r.options->start_balls == 1000);
+  CHECK(r.options->threads == WorkerPool::hardware_threads());
+  CHECK(r.options->port == 7878);
+  CHECK(r.options->bind == "127.0.0.1");
+  CHECK(r.options->physics.stiffness == PhysicsParams{}.stiffness);
+}
+
+TEST_CASE("--help lists every flag and exits 0 without starting anything", "[options]") {
+  const ParseResult r = parse({"--help"});
+  CHECK_FALSE(r.options);
+  CHECK(r.exit_code == 0);
+  for (const char* flag : {"--help",
+                           "--threads",
+                           "--seed",
+                           "--balls",
+                           "--max-balls",
+                           "--duration",
+                           "--status-interval",
+                           "--bind",
+                           "--port",
+                           "--snapshot-rate",
+                           "--max-players",
+                           "--stiffness",
+                           "--restitution",
+                           "--steps-per-contact",
+                           "--dt",
+                           "--skin",
+                           "--bench",
+                           "--scene",
+                           "--steps",
+                           "--windows",
+                           "--settle-time",
+                           "--dump",
+                           "--export-lammps",
+                           "--lammps-steps",
+                           "--record",
+                           "--record-every"}) {
+    INFO(flag);
+    CHECK(r.message.find(flag) != std::string::npos);
+  }
+  // Defaults are shown beside their flags.
+  CHECK(r.message.find("--stiffness arg (=25000)") != std::string::npos);
+  CHECK(r.message.find("--skin arg (=0.2)") != std::string::npos);
+}
+
+TEST_CASE("--bench --scene wide: the benchmark's spec, and a tank widened for the balls", "[options]") {
+  const ParseResult r = parse({"--bench", "--scene", "wide", "--balls", "100000", "--steps", "50", "--seed", "7"});
+  REQUIRE(r.options);
+  const ServerOptions& o = *r.options;
+  CHECK(o.bench);
+  CHECK(o.bench_spec.scene.name == "wide");
+  CHECK(o.bench_spec.scene.balls == 100000);
+  CHECK(o.bench_spec.scene.seed == 7);
+  CHECK(o.bench_spec.steps == 50);
+  CHECK(o.physics.tank.size().x > 200.0f);  // 40 units would hold ~6000
+  CHECK(o.physics.tank.size().y == 40.0f);
+  // Without --balls the benchmark fills the product's tank.
+  CHECK(parse({"--bench"}).options->start_balls == 6000);
+}
+
+TEST_CASE("every bad value is refused with a message naming it and exit code 2", "[options]") {
+  struct Bad {
+    std::vector<std::string> args;
+    std::string says;
+  };
+  const std::vector<Bad> bad = {
+      {{"--balls", "-5"}, "--balls must be between"},
+      {{"--balls", "20000000"}, "--balls must be between"},
+      {{"--balls", "many"}, "balls"},
+      {{"--threads", "0"}, "--threads must be between"},
+      {{"--seed", "-1"}, "--seed must be >= 0"},
+      {{"--bench", "--steps", "0"}, "--steps must be between"},
+      {{"--bench", "--steps", "5", "--windows", "10"}, "--windows must be"},
+      {{"--duration", "nan"}, "--duration"},
+      {{"--duration", "-1"}, "--duration"},
+      {{"--status-interval", "0"}, "--status-interval"},
+      {{"--settle-time", "inf"}, "--settle-time"},
+      {{"--bench", "--scene", "cube"}, "unknown scene 'cube'"},
+      {{"--port", "70000"}, "--port must be between"},
+      {{"--snapshot-rate", "0"}, "--snapshot-rate"},
+      {{"--max-players", "-1"}, "--max-players"},
+      {{"--max-balls", "-3"}, "--max-balls"},
+      {{"--record-every", "0"}, "--record-every"},
+      {{"--lammps-steps", "-1"}, "--lammps-steps"},
+      {{"--stiffness", "nan"}, "stiffness"},
+      {{"--stiffness", "-1"}, "stiffness"},
+      {{"--restitution", "0"}, "restitution"},
+      {{"--restitution", "1.5"}, "restitution"},
+      {{"--steps-per-contact", "5"}, "--steps-per-contact must be between 10 and 100000, got 5"},
+      {{"--dt", "0.01"}, "unstable for k"},
+      {{"--skin", "-0.1"}, "skin"},
+      {{"--no-such-flag"}, "no-such-flag"},
+  };
+  for (const Bad& b : bad) {
+    std::string line;
+    for (const std::string& a : b.args) line += a + " ";
+    INFO(line);
+    const ParseResult r = parse(b.args);
+    CHECK_FALSE(r.options);
+    CHECK(r.exit_code == 2);
+    CHECK(r.message.find(b.says) != std::string::npos);
+    CHECK(r.message.rfind("fishtank-server: ", 0) == 0);
+  }
+}
+
+TEST_CASE("the scalar build refuses more than one thread and says which build to use", "[options]") {
+  CHECK(parse({}, "scalar", false).options->threads == 1);
+  const ParseResult r = parse({"--threads", "2"}, "scalar", false);
+  CHECK_FALSE(r.options);
+  CHECK(r.exit_code == 2);
+  CHECK(r.message.find("fishtank-server") != std::string::npos);
+}
