@@ -1,0 +1,78 @@
+// The headless benchmark's scenes and report: the wide scene places exactly
+// the balls asked for, none overlapping; settling stops at rest or at its
+// limit; the JSON report carries every figure the issue asks for, and they
+// agree with each other and with the world they describe.
+
+#include "server/bench/benchmark.h"
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <string>
+
+using namespace fishtank;
+
+TEST_CASE("the wide scene places exactly N balls, none touching, in a tank widened for them", "[bench]") {
+  SceneSpec spec;
+  spec.name = "wide";
+  spec.balls = 2000;
+  PhysicsParams params;
+  params.tank = scene_tank(spec);
+  REQUIRE(validate(params).empty());
+  CHECK(params.tank.size().y == 40.0f);
+  World world(params, kScalarKernels, 1, 1);
+  REQUIRE(populate(world, spec).empty());
+  REQUIRE(world.ball_count() == 2000);
+  const Float4* p = world.positions();
+  float closest = 1e9f;  // the smallest gap between two balls' surfaces
+  for (std::uint32_t i = 0; i < world.ball_count(); ++i)
+    for (std::uint32_t j = i + 1; j < world.ball_count(); ++j) {
+      const float dx = p[i].x - p[j].x, dy = p[i].y - p[j].y, dz = p[i].z - p[j].z;
+      closest = std::min(closest, std::sqrt(dx * dx + dy * dy + dz * dz) - p[i].w - p[j].w);
+    }
+  CHECK(closest > 0.0f);
+  CHECK(world.escaped_or_invalid() == 0);
+}
+
+TEST_CASE("the benchmark report holds every figure asked for, consistent with the run", "[bench]") {
+  BenchSpec spec;
+  spec.scene.balls = 300;
+  spec.scene.max_settle_seconds = 2.0;
+  spec.steps = 40;
+  spec.windows = 4;
+  World world(PhysicsParams{}, kSseKernels, 2, spec.scene.seed);
+  REQUIRE(populate(world, spec.scene).empty());
+  const SettleReport settled = settle(world, spec.scene);
+  CHECK(settled.sim_seconds <= 2.0 + 0.11);  // stops at its limit, checked every tenth of a second
+  CHECK(settled.steps == world.steps());
+  REQUIRE(world.pending() == 0);
+
+  const nlohmann::json j = time_steps(world, spec, settled);
+  for (const char* key : {"variant", "simd", "threads", "balls", "steps", "seconds", "steps_per_s", "ball_steps_per_s",
+                          "dt", "k", "max_overlap", "pile_top", "phase_seconds", "settle", "peak_rss_mib"}) {
+    INFO(key);
+    CHECK(j.contains(key));
+  }
+  CHECK(j["variant"] == "sse");
+  CHECK(j["balls"] == 300);
+  CHECK(j["steps"] == 40);
+  CHECK(world.steps() == settled.steps + 40);
+  CHECK(j["dt"].get<double>() == Approx(world.dt()));
+  CHECK(j["k"].get<double>() == Approx(25000.0));
+  const double seconds = j["seconds"], rate = j["ball_steps_per_s"];
+  CHECK(seconds > 0.0);
+  CHECK(j["steps_per_s"].get<double>() * 300.0 == Approx(rate));
+  // The rate is the median window's: between the slowest and the fastest.
+  const auto windows = j["window_ball_steps_per_s"].get<std::vector<double>>();
+  REQUIRE(windows.size() == 4);
+  CHECK(rate >= *std::min_element(windows.begin(), windows.end()));
+  CHECK(rate <= *std::max_element(windows.begin(), windows.end()));
+  const double phases = j["phase_seconds"]["step_pass"].get<double>() + j["phase_seconds"]["neighbours"].get<double>();
+  CHECK(j["phase_seconds"]["step_pass"].get<double>() > 0.0);
+  CHECK(phases <= seconds * 1.01 + 1e-4);  // the phases are parts of the timed steps
+  CHECK(j["max_overlap"].get<double>() >= 0.0);
+  CHECK(j["max_overlap"].get<double>() < 0.1);
+  CHECK(j["pile_top"].get<double>() > 0.0);
+  CHECK(j["pile_top"].get<double>() <= 40.0);
+  CHECK(j["settle"]["settled"] == settled.settled);
+}
