@@ -35,7 +35,7 @@ TEST_CASE("no flags: the paced server with 1000 balls on every core and the defa
   CHECK(r.options->physics.stiffness == PhysicsParams{}.stiffness);
 }
 
-TEST_CASE("--help lists every flag and exits 0 without starting anything", "[options]") {
+TEST_CASE("the help text (--help) lists every flag and exits 0 without starting anything", "[options]") {
   const ParseResult r = parse({"--help"});
   CHECK_FALSE(r.options);
   CHECK(r.exit_code == 0);
@@ -73,7 +73,7 @@ TEST_CASE("--help lists every flag and exits 0 without starting anything", "[opt
   CHECK(r.message.find("--skin arg (=0.2)") != std::string::npos);
 }
 
-TEST_CASE("--bench --scene wide: the benchmark's spec, and a tank widened for the balls", "[options]") {
+TEST_CASE("the wide benchmark's flags give its spec, and a tank widened for the balls", "[options]") {
   const ParseResult r = parse({"--bench", "--scene", "wide", "--balls", "100000", "--steps", "50", "--seed", "7"});
   REQUIRE(r.options);
   const ServerOptions& o = *r.options;
