@@ -26,6 +26,22 @@ inline float wall_force_1d(const ContactModel& m, float pos, float vel, float r,
   return f;
 }
 
+// The spring-dashpot force on ball i (position pi, half-step velocity vi)
+// from ball j, zero unless they touch.
+inline Float4 contact_force(const ContactModel& m, const Float4& pi, const Float4& vi, const Float4& pj,
+                            const Float4& vj) {
+  const float dx = pi.x - pj.x, dy = pi.y - pj.y, dz = pi.z - pj.z;
+  const float d2 = dx * dx + dy * dy + dz * dz;
+  const float reach = pi.w + pj.w;
+  if (d2 >= reach * reach) return Float4{};
+  const float dist = std::max(std::sqrt(d2), 1e-6f);
+  const float inv_dist = 1.0f / dist;
+  const float nx = dx * inv_dist, ny = dy * inv_dist, nz = dz * inv_dist;
+  const float v_n = (vi.x - vj.x) * nx + (vi.y - vj.y) * ny + (vi.z - vj.z) * nz;
+  const float f = normal_force(m, reach - dist, v_n, vi.w + vj.w);
+  return Float4{f * nx, f * ny, f * nz, 0.0f};
+}
+
 // Sum of the spring-dashpot forces of ball i's neighbours, (Fx, Fy, Fz, 0).
 [[gnu::always_inline]] inline Float4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t i,
                                                  const std::uint32_t* list) {
@@ -33,20 +49,10 @@ inline float wall_force_1d(const ContactModel& m, float pos, float vel, float r,
   const Float4 vi = s.vel_half[i];
   float fx = 0.0f, fy = 0.0f, fz = 0.0f;
   for (std::uint32_t n = 0; n < s.neighbour_count[i]; ++n) {
-    const Float4& pj = listed(s.pos, list[n]);
-    float dx = pi.x - pj.x, dy = pi.y - pj.y, dz = pi.z - pj.z;
-    float d2 = dx * dx + dy * dy + dz * dz;
-    float reach = pi.w + pj.w;
-    if (d2 >= reach * reach) continue;
-    const Float4& vj = listed(s.vel_half, list[n]);
-    float dist = std::max(std::sqrt(d2), 1e-6f);
-    float inv_dist = 1.0f / dist;
-    float nx = dx * inv_dist, ny = dy * inv_dist, nz = dz * inv_dist;
-    float v_n = (vi.x - vj.x) * nx + (vi.y - vj.y) * ny + (vi.z - vj.z) * nz;
-    float f = normal_force(m, reach - dist, v_n, vi.w + vj.w);
-    fx += f * nx;
-    fy += f * ny;
-    fz += f * nz;
+    const Float4 f = contact_force(m, pi, vi, listed(s.pos, list[n]), listed(s.vel_half, list[n]));
+    fx += f.x;
+    fy += f.y;
+    fz += f.z;
   }
   return Float4{fx, fy, fz, 0.0f};
 }
