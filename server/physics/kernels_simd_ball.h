@@ -247,7 +247,7 @@ inline void prefetch(const void* base, std::size_t bytes) {
 // of the rows and lists of the batch kPrefetchBatches ahead: share is the
 // group's place in its batch. At 1 000 000 balls asking one batch ahead took
 // the step pass from 28.7 to 23.7 ns per ball-step, and four ahead (~60 KB of
-// rows and lists, a few microseconds of work) from 16.0-18.6 to 11.3-12.1
+// rows and lists, a few microseconds of work) from 16.0-19.2 to 11.3-12.1
 // against one: one batch's ~2 us did not cover the memory's latency under two
 // threads' misses. From cache it changes nothing measurable, and it costs 3 %
 // more instructions, so the world asks for it only for piles larger than the
