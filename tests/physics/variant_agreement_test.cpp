@@ -58,22 +58,31 @@ TEST_CASE("scalar and SSE trajectories agree over a short horizon", "[physics][v
 }
 
 TEST_CASE("scalar and SSE settle into the same pile", "[physics][variants][slow]") {
-  World scalar(PhysicsParams{}, kScalarKernels, 1, 5);
-  World sse(PhysicsParams{}, kSseKernels, 2, 5);
-  pour_and_settle(scalar, 1500, 40.0);
-  pour_and_settle(sse, 1500, 40.0);
-  REQUIRE(scalar.ball_count() == 1500);
-  REQUIRE(sse.ball_count() == 1500);
-  auto mean_height = [](const World& w) {
-    double sum = 0.0;
-    for (std::uint32_t i = 0; i < w.ball_count(); ++i) sum += w.positions()[i].y;
-    return sum / w.ball_count();
+  // A pour is chaotic: one variant's piles from different seeds differ in mean
+  // height by up to ~4 %, so the statistics are averaged over four pours each.
+  struct Pile {
+    double mean_height = 0.0, top = 0.0, overlap = 0.0;
   };
-  INFO("mean height " << mean_height(scalar) << " vs " << mean_height(sse) << ", pile top " << scalar.pile_top()
-                      << " vs " << sse.pile_top());
-  CHECK(mean_height(scalar) == Approx(mean_height(sse)).epsilon(0.03));
-  CHECK(scalar.pile_top() == Approx(sse.pile_top()).margin(1.5));
-  CHECK(scalar.max_overlap_fraction() == Approx(sse.max_overlap_fraction()).margin(0.03));
+  auto settled = [](const Kernels& kernels, int threads) {
+    Pile average;
+    for (int seed = 5; seed < 9; ++seed) {
+      World world(PhysicsParams{}, kernels, threads, seed);
+      pour_and_settle(world, 1500, 40.0);
+      REQUIRE(world.ball_count() == 1500);
+      double sum = 0.0;
+      for (std::uint32_t i = 0; i < world.ball_count(); ++i) sum += world.positions()[i].y;
+      average.mean_height += sum / world.ball_count() / 4;
+      average.top += world.pile_top() / 4;
+      average.overlap += world.max_overlap_fraction() / 4;
+    }
+    return average;
+  };
+  const Pile scalar = settled(kScalarKernels, 1), sse = settled(kSseKernels, 2);
+  INFO("mean height " << scalar.mean_height << " vs " << sse.mean_height << ", pile top " << scalar.top << " vs "
+                      << sse.top << ", largest overlap " << scalar.overlap << " vs " << sse.overlap);
+  CHECK(scalar.mean_height == Approx(sse.mean_height).epsilon(0.03));
+  CHECK(scalar.top == Approx(sse.top).margin(1.5));
+  CHECK(scalar.overlap == Approx(sse.overlap).margin(0.03));
 }
 
 TEST_CASE("scalar and AVX2 trajectories agree over a short horizon", "[physics][variants]") {
