@@ -6,11 +6,11 @@
 // (kernels_sse.cpp), eight in F8 (kernels_avx2.cpp); each file says how to
 // gather and scatter its lanes (Lanes<V>). For its neighbour sums each lane
 // walks its own ball's list, one neighbour per block, so a group costs as
-// many blocks as its longest list: the list build orders each list nearest first
-// (order_nearest_first, broadphase.h), forms groups of balls with similar counts
-// of contacts and of neighbours (by_contacts) and lays their lists out block
-// by block (build_lists, and broadphase.h for the layout); the step then
-// skips the force of blocks in which no lane touches. Walls,
+// many blocks as its longest list: the list build orders each list nearest
+// first (order_nearest_first, broadphase.h), forms groups of balls with
+// similar counts of contacts and of neighbours (by_contacts) and lays their
+// lists out block by block (build_lists, and broadphase.h for the layout);
+// the step then skips the force of blocks in which no lane touches. Walls,
 // player spheres, kick and drift then serve the whole group per instruction
 // too.
 //
@@ -99,8 +99,8 @@ inline std::uint32_t by_contacts(const std::uint8_t* keys, std::uint32_t first, 
 // The lists of balls [begin, end), laid out for groups of kLanes balls
 // (broadphase.h): each batch's lists are found into rows of a scratch buffer
 // that stays in the cache and ordered nearest first, the batch is ordered by
-// contacts, and each group's
-// rows are interleaved into blocks, the ghost where a list has ended. The
+// contacts, and each group's rows are interleaved into blocks, the ghost
+// where a list has ended. The
 // step then reads one contiguous block per vector of neighbours, and the
 // lists take as much memory as the groups need, not a stride per ball.
 template <std::uint32_t kLanes>
@@ -179,9 +179,9 @@ template <class V>
     const V d2 = mul_add(dz, dz, mul_add(dy, dy, dx * dx));
     const V reach = rj + i.r;
     const auto touching = d2 < reach * reach;
-    // The lists are ordered nearest first at the build, and groups formed by their
-    // contacts: the last blocks of a group are usually the pairs only the
-    // skin keeps, with no force to compute.
+    // The lists are ordered nearest first at the build, and groups formed by
+    // their contacts: the last blocks of a group are usually the pairs only
+    // the skin keeps, with no force to compute.
     if (!simd::any(touching)) continue;
     V dvx, dvy, dvz, inv_mj;
     Lanes<V>::load(s.vel_half, block, dvx, dvy, dvz, inv_mj);
