@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
-#include <vector>
 
 namespace fishtank {
 
@@ -20,32 +18,6 @@ void NeighbourList::configure(const TankBounds& tank, float skin) {
   block_ = std::min(kBlockCells, nx_);
   const int blocks = (nx_ + block_ - 1) / block_;  // the last may be part empty
   cell_start_.assign(std::size_t(blocks) * block_ * ny_ * nz_ + 1, 0);
-}
-
-std::uint32_t order_nearest_first(const Float4* pos, std::uint32_t i, std::uint32_t* neighbours, std::uint32_t count) {
-  thread_local std::vector<float> keys;
-  thread_local std::vector<std::uint32_t> found;
-  keys.resize(count);
-  found.assign(neighbours, neighbours + count);
-  std::uint32_t touching = 0;
-  const Float4& pi = pos[i];
-  for (std::uint32_t k = 0; k < count; ++k) {
-    const Float4& pj = pos[found[k]];
-    const float dx = pj.x - pi.x, dy = pj.y - pi.y, dz = pj.z - pi.z;
-    const float d2 = dx * dx + dy * dy + dz * dz, reach = pi.w + pj.w;
-    touching += d2 < reach * reach;  // the steps' own test
-    const float key = d2 - reach * reach;
-    keys[k] = key == key ? key : std::numeric_limits<float>::infinity();  // NaN last: the places stay distinct
-  }
-  // Each entry's place is the number of entries before it in the order (equal
-  // keys in the order found): no branch to mispredict, and lists are short
-  // (7.5 entries in the settled tank).
-  for (std::uint32_t k = 0; k < count; ++k) {
-    std::uint32_t place = 0;
-    for (std::uint32_t m = 0; m < count; ++m) place += keys[m] < keys[k] || (keys[m] == keys[k] && m < k);
-    neighbours[place] = found[k];
-  }
-  return touching;
 }
 
 CellCoord NeighbourList::cell_of(const Float4& p) const {

@@ -94,15 +94,6 @@ inline void write_group_record(const Float4* pos, const std::uint32_t* group, st
   }
 }
 
-// Orders ball i's neighbours (indices into pos) nearest first, by
-// d^2 - (r_i + r_j)^2 (negative exactly while they touch, and growing with
-// the gap between the surfaces), and returns how many touch now. Every twin's
-// build calls it, so each ball sums its forces in the same order in all of
-// them. A SIMD step skips the force of a block in which no lane touches: in
-// this order those are a group's last blocks, which hold the pairs only the
-// skin keeps (kernels_simd_ball.h).
-std::uint32_t order_nearest_first(const Float4* pos, std::uint32_t i, std::uint32_t* neighbours, std::uint32_t count);
-
 // The balls a batch's lists name lie in [lowest, highest] (lowest > highest
 // when they name none). Batches near a chunk's edge name balls of the
 // neighbouring chunk: the world asks for those rows ahead

@@ -138,15 +138,12 @@ std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t
         float dx = pi.x - pj.x, dy = pi.y - pj.y, dz = pi.z - pj.z;
         float cutoff = pi.w + pj.w + b.skin;
         if (dx * dx + dy * dy + dz * dz >= cutoff * cutoff || j == i) continue;
-        if (count < b.stride) list[count] = j;
+        if (count < b.stride) list[count] = list_entry(j);
         ++count;
       }
     });
     b.counts[i] = count;
-    const std::uint32_t stored = std::min(count, b.stride);
-    order_nearest_first(b.pos, i, list, stored);
-    for (std::uint32_t k = 0; k < stored; ++k) list[k] = list_entry(list[k]);
-    list += stored;
+    list += std::min(count, b.stride);
     longest = std::max(longest, count);
   }
   return longest;

@@ -6,11 +6,9 @@
 // (kernels_sse.cpp), eight in F8 (kernels_avx2.cpp); each file says how to
 // gather and scatter its lanes (Lanes<V>). For its neighbour sums each lane
 // walks its own ball's list, one neighbour per block, so a group costs as
-// many blocks as its longest list: the list build orders each list nearest
-// first (order_nearest_first, broadphase.h), forms groups of balls with
-// similar counts of contacts and of neighbours (by_contacts) and lays their
-// lists out block by block (build_lists, and broadphase.h for the layout);
-// the step then skips the force of blocks in which no lane touches. Walls,
+// many blocks as its longest list: the list build forms groups of balls with
+// similar neighbour counts (by_neighbour_count) and lays their lists out
+// block by block (build_lists, and broadphase.h for the layout). Walls,
 // player spheres, kick and drift then serve the whole group per instruction
 // too.
 //
@@ -70,27 +68,18 @@ inline std::uint32_t list_of(const ListBuild& b, std::uint32_t i, std::uint32_t*
   return count;
 }
 
-// A ball's place in the order of its batch: by how many neighbours touch it,
-// then by how many more its list holds. A group costs as many blocks as its
-// longest list, and as many with a force to compute as its most touching
-// ball's contacts (order_nearest_first puts them first): grouping balls alike in
-// both keeps both kinds of block full. Counts past 15 share a key: only the
-// grouping is coarser.
-inline std::uint8_t contacts_key(std::uint32_t touching, std::uint32_t listed) {
-  return std::uint8_t(std::min(touching, 15u) * 16 + std::min(listed - touching, 15u));
-}
-
-// Balls first..end-1 of a batch by their contacts_key (a counting sort;
-// keys[b - first] is ball b's), padded to a multiple of `lanes` with the
-// last one repeated: a repeated ball is computed twice and stored twice,
-// with the same result. Returns the length.
-inline std::uint32_t by_contacts(const std::uint8_t* keys, std::uint32_t first, std::uint32_t end, std::uint32_t lanes,
-                                 std::uint32_t* order) {
-  constexpr std::uint32_t kBuckets = 256;
+// Balls first..end-1 of a batch, by neighbour count (a counting sort), padded
+// to a multiple of `lanes` with the last one repeated: a repeated ball is
+// computed twice and stored twice, with the same result. Returns the length.
+// A group costs as many blocks as its longest list; grouping balls of equal
+// counts keeps the blocks full (see the top of this file).
+inline std::uint32_t by_neighbour_count(const std::uint32_t* counts, std::uint32_t first, std::uint32_t end,
+                                        std::uint32_t lanes, std::uint32_t* order) {
+  constexpr std::uint32_t kBuckets = 32;  // longer lists share the last bucket: only the grouping is coarser
   std::uint32_t start[kBuckets + 1] = {};
-  for (std::uint32_t b = first; b < end; ++b) ++start[keys[b - first] + 1];
+  for (std::uint32_t b = first; b < end; ++b) ++start[std::min(counts[b], kBuckets - 1) + 1];
   for (std::uint32_t c = 1; c <= kBuckets; ++c) start[c] += start[c - 1];
-  for (std::uint32_t b = first; b < end; ++b) order[start[keys[b - first]]++] = b;
+  for (std::uint32_t b = first; b < end; ++b) order[start[std::min(counts[b], kBuckets - 1)]++] = b;
   std::uint32_t n = end - first;
   for (; n % lanes != 0; ++n) order[n] = order[n - 1];
   return n;
@@ -98,9 +87,8 @@ inline std::uint32_t by_contacts(const std::uint8_t* keys, std::uint32_t first, 
 
 // The lists of balls [begin, end), laid out for groups of kLanes balls
 // (broadphase.h): each batch's lists are found into rows of a scratch buffer
-// that stays in the cache and ordered nearest first, the batch is ordered by
-// contacts, and each group's rows are interleaved into blocks, the ghost
-// where a list has ended. The
+// that stays in the cache, the batch is ordered by count, and each group's
+// rows are interleaved into blocks, the ghost where a list has ended. The
 // step then reads one contiguous block per vector of neighbours, and the
 // lists take as much memory as the groups need, not a stride per ball.
 template <std::uint32_t kLanes>
@@ -111,18 +99,15 @@ std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t
   for (std::uint32_t batch = begin, last_of_batch; batch < end; batch = last_of_batch) {
     last_of_batch = batch_end(batch, end);
     BatchReach reach;  // a local: stores to the lists cannot change it
-    std::uint8_t keys[kStepBatch];
     for (std::uint32_t i = batch; i < last_of_batch; ++i) {
       std::uint32_t* const row = rows.data() + std::size_t(i - batch) * b.stride;
       b.counts[i] = list_of(b, i, row);
       longest = std::max(longest, b.counts[i]);
-      const std::uint32_t stored = std::min(b.counts[i], b.stride);
-      keys[i - batch] = contacts_key(order_nearest_first(b.pos, i, row, stored), stored);
-      for (std::uint32_t k = 0; k < stored; ++k) reach.add(row[k]);
+      for (std::uint32_t k = 0; k < std::min(b.counts[i], b.stride); ++k) reach.add(row[k]);
     }
     b.reach[batch / kStepBatch] = reach;
     std::uint32_t* order = b.batch_order + batch;
-    const std::uint32_t grouped = by_contacts(keys, batch, last_of_batch, kLanes, order);
+    const std::uint32_t grouped = by_neighbour_count(b.counts, batch, last_of_batch, kLanes, order);
     std::uint32_t* block = b.neighbours + std::size_t(batch) * b.stride;
     for (const std::uint32_t* group = order; group < order + grouped; group += kLanes) {
       const std::uint32_t* row[kLanes];
@@ -179,10 +164,7 @@ template <class V>
     const V d2 = mul_add(dz, dz, mul_add(dy, dy, dx * dx));
     const V reach = rj + i.r;
     const auto touching = d2 < reach * reach;
-    // The lists are ordered nearest first at the build, and groups formed by
-    // their contacts: the last blocks of a group are usually the pairs only
-    // the skin keeps, with no force to compute.
-    if (!simd::any(touching)) continue;
+    // Velocities for every block: in a pile 99 % of blocks have a lane in contact.
     V dvx, dvy, dvz, inv_mj;
     Lanes<V>::load(s.vel_half, block, dvx, dvy, dvz, inv_mj);
     dvx -= i.vx, dvy -= i.vy, dvz -= i.vz;
