@@ -59,21 +59,22 @@ TEST_CASE("scalar and SSE trajectories agree over a short horizon", "[physics][v
 
 TEST_CASE("scalar and SSE settle into the same pile", "[physics][variants][slow]") {
   // A pour is chaotic: one variant's piles from different seeds differ in mean
-  // height by up to ~4 %, so the statistics are averaged over four pours each.
+  // height by up to ~4 %, so the statistics are averaged over kPours pours each.
   struct Pile {
     double mean_height = 0.0, top = 0.0, overlap = 0.0;
   };
+  constexpr int kPours = 4, kFirstSeed = 5;
   auto settled = [](const Kernels& kernels, int threads) {
     Pile average;
-    for (int seed = 5; seed < 9; ++seed) {
+    for (int seed = kFirstSeed; seed < kFirstSeed + kPours; ++seed) {
       World world(PhysicsParams{}, kernels, threads, seed);
       pour_and_settle(world, 1500, 40.0);
       REQUIRE(world.ball_count() == 1500);
       double sum = 0.0;
       for (std::uint32_t i = 0; i < world.ball_count(); ++i) sum += world.positions()[i].y;
-      average.mean_height += sum / world.ball_count() / 4;
-      average.top += world.pile_top() / 4;
-      average.overlap += world.max_overlap_fraction() / 4;
+      average.mean_height += sum / world.ball_count() / kPours;
+      average.top += world.pile_top() / kPours;
+      average.overlap += world.max_overlap_fraction() / kPours;
     }
     return average;
   };
