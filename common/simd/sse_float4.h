@@ -29,6 +29,7 @@ struct F4 {
   // Four floats stored as their bits (16-byte aligned); the intrinsic's load may alias any type.
   static F4 load_bits(const std::uint32_t* bits) { return {_mm_load_ps(reinterpret_cast<const float*>(bits))}; }
   void store(Float4& f) const { _mm_store_ps(&f.x, v); }
+  void storeu(float* f) const { _mm_storeu_ps(f, v); }
 };
 
 inline F4 operator+(F4 a, F4 b) { return {_mm_add_ps(a.v, b.v)}; }
@@ -84,7 +85,12 @@ struct I4 {
   static I4 iota(std::uint32_t first) {  // first, first + 1, first + 2, first + 3
     return {_mm_add_epi32(_mm_set1_epi32(static_cast<int>(first)), _mm_setr_epi32(0, 1, 2, 3))};
   }
+  static I4 splat(std::uint32_t s) { return {_mm_set1_epi32(static_cast<int>(s))}; }
+  void store(std::uint32_t* out) const { _mm_store_si128(reinterpret_cast<__m128i*>(out), v); }
 };
+
+// counts plus one in the lanes where m is set (a set lane is all ones: -1).
+inline I4 count_where(M4 m, I4 counts) { return {_mm_sub_epi32(counts.v, _mm_castps_si128(m.v))}; }
 
 // The lanes of a whose bit is set in mask, packed to the front in lane order
 // and stored at out; all 16 bytes are written, whatever the count.
@@ -102,6 +108,11 @@ inline void compress_store(I4 a, int mask, std::uint32_t* out) {
   };
   const __m128i gather = _mm_load_si128(reinterpret_cast<const __m128i*>(kGather[mask]));
   _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm_shuffle_epi8(a.v, gather));
+}
+
+// The same for floats (the intrinsic's store may alias any type).
+inline void compress_store(F4 a, int mask, float* out) {
+  compress_store(I4{_mm_castps_si128(a.v)}, mask, reinterpret_cast<std::uint32_t*>(out));
 }
 
 }  // namespace FISHTANK_SIMD_ISA_NAMESPACE

@@ -118,6 +118,34 @@ void report_block_counts(benchmark::State& state, const std::uint32_t* counts, s
   state.counters["blocks8_eight_balls_by_count"] = eight_by_count / n;
 }
 
+// Per ball, as a SIMD build laid the lists out: contacts, blocks, and the
+// blocks in which some lane touches, whose force the step computes.
+void report_layout(benchmark::State& state, const fishtank::NeighbourList& list, const fishtank::Float4* pos,
+                   std::uint32_t n, std::uint32_t lanes) {
+  double contacts = 0, blocks = 0, force_blocks = 0;
+  for (std::uint32_t batch = 0; batch < n; batch += fishtank::kStepBatch) {
+    const std::uint32_t* block = list.neighbours() + std::size_t(batch) * list.stride();
+    const std::uint32_t* const order = list.batch_order();
+    const std::uint32_t grouped = fishtank::grouped_length(fishtank::batch_end(batch, n) - batch, lanes);
+    for (std::uint32_t place = batch; place < batch + grouped; place += lanes)
+      for (std::uint32_t k = 0; k < list.group_blocks()[place / lanes]; ++k, block += lanes) {
+        int touching = 0;
+        for (std::uint32_t l = 0; l < lanes; ++l) {
+          const fishtank::Float4 &pi = pos[order[place + l]], &pj = fishtank::listed(pos, block[l]);
+          const float dx = pj.x - pi.x, dy = pj.y - pi.y, dz = pj.z - pi.z, reach = pi.w + pj.w;
+          const bool touches = dx * dx + dy * dy + dz * dz < reach * reach;
+          touching += touches;
+          contacts += touches && (l == 0 || order[place + l] != order[place + l - 1]);  // a padded lane repeats
+        }
+        blocks += 1;
+        force_blocks += touching > 0;
+      }
+  }
+  state.counters["contacts"] = contacts / n;
+  state.counters["blocks"] = blocks / n;
+  state.counters["force_blocks"] = force_blocks / n;
+}
+
 void build_lists(benchmark::State& state, const fishtank::Kernels& kernels) {
   fishtank::PhysicsParams params;
   fishtank::AlignedVector<fishtank::Float4> unsorted;
@@ -134,6 +162,7 @@ void build_lists(benchmark::State& state, const fishtank::Kernels& kernels) {
   const fishtank::ListBuild build = list.build_view(pos.data(), n);
   for (auto _ : state) benchmark::DoNotOptimize(kernels.build_lists(build, 0, n));
   report_block_counts(state, list.counts(), n);
+  if (kernels.list_lanes > 1) report_layout(state, list, pos.data(), n, kernels.list_lanes);
 }
 
 // One wide-scene world per size, dropped and run for the scene's 4 simulated

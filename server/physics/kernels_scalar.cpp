@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "server/physics/kernels.h"
 
@@ -123,8 +124,28 @@ void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std:
   }
 }
 
+// Ball i's count entries, as found with their keys d^2 - (r_i + r_j)^2, into
+// list nearest first, ties in the order found. The key is negative exactly
+// while the pair touches and grows with the gap between the surfaces. Every
+// twin's build orders its lists so (kernels_simd_ball.h has the SIMD one),
+// and each ball sums its forces in the same order in all of them; a SIMD step
+// skips the force of a block in which no lane touches, which in this order
+// are a group's last blocks, the pairs only the skin keeps. Each entry's
+// place is the number of entries before it in the order.
+void order_nearest_first(const float* keys, const std::uint32_t* found, std::uint32_t count, std::uint32_t* list) {
+  for (std::uint32_t k = 0; k < count; ++k) {
+    std::uint32_t place = 0;
+    for (std::uint32_t m = 0; m < count; ++m) place += keys[m] < keys[k] || (keys[m] == keys[k] && m < k);
+    list[place] = list_entry(found[k]);
+  }
+}
+
 // One lane: each batch's lists one after the other, in ball order (broadphase.h).
 std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t end) {
+  thread_local std::vector<std::uint32_t> found;
+  thread_local std::vector<float> keys;
+  found.resize(b.stride);
+  keys.resize(b.stride);
   std::uint32_t longest = 0;
   std::uint32_t* list = nullptr;
   for (std::uint32_t i = begin; i < end; ++i) {
@@ -135,15 +156,17 @@ std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t
     for_each_neighbour_range(b, i, [&](std::uint32_t j_begin, std::uint32_t j_end) {
       for (std::uint32_t j = j_begin; j < j_end; ++j) {
         const Float4& pj = b.pos[j];
-        float dx = pi.x - pj.x, dy = pi.y - pj.y, dz = pi.z - pj.z;
-        float cutoff = pi.w + pj.w + b.skin;
-        if (dx * dx + dy * dy + dz * dz >= cutoff * cutoff || j == i) continue;
-        if (count < b.stride) list[count] = list_entry(j);
+        const float dx = pi.x - pj.x, dy = pi.y - pj.y, dz = pi.z - pj.z;
+        const float d2 = dx * dx + dy * dy + dz * dz, reach = pi.w + pj.w, cutoff = reach + b.skin;
+        if (!(d2 < cutoff * cutoff) || j == i) continue;  // a NaN is no neighbour, as in the SIMD builds
+        if (count < b.stride) found[count] = j, keys[count] = d2 - reach * reach;
         ++count;
       }
     });
     b.counts[i] = count;
-    list += std::min(count, b.stride);
+    const std::uint32_t stored = std::min(count, b.stride);
+    order_nearest_first(keys.data(), found.data(), stored, list);
+    list += stored;
     longest = std::max(longest, count);
   }
   return longest;

@@ -6,9 +6,11 @@
 // (kernels_sse.cpp), eight in F8 (kernels_avx2.cpp); each file says how to
 // gather and scatter its lanes (Lanes<V>). For its neighbour sums each lane
 // walks its own ball's list, one neighbour per block, so a group costs as
-// many blocks as its longest list: the list build forms groups of balls with
-// similar neighbour counts (by_neighbour_count) and lays their lists out
-// block by block (build_lists, and broadphase.h for the layout). Walls,
+// many blocks as its longest list: the list build orders each list nearest
+// first (order_nearest_first), forms groups of balls with similar list
+// lengths and then counts of contacts (by_length_and_contacts) and lays
+// their lists out block by block (build_lists, and broadphase.h for the
+// layout); the step skips the force of blocks in which no lane touches. Walls,
 // player spheres, kick and drift then serve the whole group per instruction
 // too.
 //
@@ -19,6 +21,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "common/simd/sse_float4.h"
@@ -30,56 +33,102 @@ namespace {
 using simd::F4;
 using simd::M4;
 
-// Ball i's list into list (at most b.stride entries); returns its true count.
-// Four candidates at a time: a cell range is contiguous in the sorted arrays,
-// so four consecutive balls are tested at once, with one load per axis from
-// ListBuild's axis arrays, and the indices of those within reach are packed
-// into the list with one byte shuffle, with no branch per candidate (the
-// scalar build mispredicts on most of them).
-inline std::uint32_t list_of(const ListBuild& b, std::uint32_t i, std::uint32_t* list) {
-  // Set bits of a 4-bit mask (the SSE4.1 build has no popcnt instruction:
-  // __builtin_popcount would be a library call).
-  static constexpr std::uint8_t kFoundCount[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+// Set bits of a 4-bit mask (the SSE4.1 build has no popcnt instruction:
+// __builtin_popcount would be a library call).
+constexpr std::uint8_t kSetBits[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+
+// Ball i's list as found into found (at most b.stride entries), and beside
+// each entry its key d^2 - (r_i + r_j)^2 (order_nearest_first); returns the
+// true count. Four candidates at a time: a cell range is contiguous in the
+// sorted arrays, so four consecutive balls are tested at once, with one load
+// per axis from ListBuild's axis arrays, and the indices and keys of those
+// within reach are packed into found and keys with one byte shuffle each,
+// with no branch per candidate (the scalar build mispredicts on most of them).
+inline std::uint32_t list_of(const ListBuild& b, std::uint32_t i, std::uint32_t* found, float* keys) {
   static constexpr std::uint8_t kFirstLanes[5] = {0x0, 0x1, 0x3, 0x7, 0xf};  // the first k lanes' bits
   const float *const xs = b.x, *const ys = b.y, *const zs = b.z, *const rs = b.r;
   const std::uint32_t stride = b.stride;
-  const F4 xi = F4::splat(xs[i]), yi = F4::splat(ys[i]), zi = F4::splat(zs[i]), ri_skin = F4::splat(rs[i] + b.skin);
+  const F4 xi = F4::splat(xs[i]), yi = F4::splat(ys[i]), zi = F4::splat(zs[i]), ri = F4::splat(rs[i]);
+  const F4 skin = F4::splat(b.skin);
   std::uint32_t count = 0;
   for_each_neighbour_range(b, i, [&](std::uint32_t j_begin, std::uint32_t j_end) {
     for (std::uint32_t j = j_begin; j < j_end; j += 4) {  // may read up to 3 ghosts past the end
       const F4 dx = F4::loadu(xs + j) - xi, dy = F4::loadu(ys + j) - yi, dz = F4::loadu(zs + j) - zi;
-      const F4 cutoff = F4::loadu(rs + j) + ri_skin;  // ri + rj + skin
+      const F4 d2 = dx * dx + dy * dy + dz * dz, reach = F4::loadu(rs + j) + ri, cutoff = reach + skin;
+      const F4 key = d2 - reach * reach;
       // Lanes past the range's end, and ball i itself, are not neighbours.
-      int found = bits(dx * dx + dy * dy + dz * dz < cutoff * cutoff) & kFirstLanes[std::min(j_end - j, 4u)];
-      if (i - j < 4) found &= ~(1 << (i - j));
+      int within = bits(d2 < cutoff * cutoff) & kFirstLanes[std::min(j_end - j, 4u)];
+      if (i - j < 4) within &= ~(1 << (i - j));
       if (count + 4 > stride) {  // nearly full: one by one, counting on so the caller can grow the list
-        for (std::uint32_t lane = 0; lane < 4; ++lane, found >>= 1)
-          if (found & 1) {
-            if (count < stride) list[count] = j + lane;
+        alignas(16) float lane_keys[4];
+        key.storeu(lane_keys);
+        for (std::uint32_t lane = 0; lane < 4; ++lane, within >>= 1)
+          if (within & 1) {
+            if (count < stride) found[count] = j + lane, keys[count] = lane_keys[lane];
             ++count;
           }
         continue;
       }
       // No branch on whether any was found: it would be mispredicted often.
-      compress_store(simd::I4::iota(j), found, list + count);
-      count += kFoundCount[found];
+      compress_store(simd::I4::iota(j), within, found + count);
+      compress_store(key, within, keys + count);
+      count += kSetBits[within];
     }
   });
   return count;
 }
 
-// Balls first..end-1 of a batch, by neighbour count (a counting sort), padded
-// to a multiple of `lanes` with the last one repeated: a repeated ball is
-// computed twice and stored twice, with the same result. Returns the length.
-// A group costs as many blocks as its longest list; grouping balls of equal
-// counts keeps the blocks full (see the top of this file).
-inline std::uint32_t by_neighbour_count(const std::uint32_t* counts, std::uint32_t first, std::uint32_t end,
-                                        std::uint32_t lanes, std::uint32_t* order) {
-  constexpr std::uint32_t kBuckets = 32;  // longer lists share the last bucket: only the grouping is coarser
+// Ball i's count entries, as found with their keys, into row nearest first
+// (see kernels_scalar.cpp's twin for the order); returns how many touch.
+// Each entry's place is the number of entries with a smaller key, found for
+// four entries per instruction; entries with equal keys then take the next
+// free places in the order found. Lists are short (7.5 entries in the
+// settled tank) and the only branch, on a place being taken, almost never
+// goes the other way. keys is read up to three entries past count.
+inline std::uint32_t order_nearest_first(const float* keys, const std::uint32_t* found, std::uint32_t count,
+                                         std::uint32_t* row) {
+  constexpr std::uint32_t kFree = ~0u;  // no ball's index
+  std::fill(row, row + count, kFree);
+  std::uint32_t touching = 0;
+  for (std::uint32_t first = 0; first < count; first += 4) {
+    const F4 mine = F4::loadu(keys + first);
+    simd::I4 smaller = simd::I4::splat(0);
+    for (std::uint32_t m = 0; m < count; ++m) smaller = count_where(F4::splat(keys[m]) < mine, smaller);
+    alignas(16) std::uint32_t place[4];
+    smaller.store(place);
+    for (std::uint32_t k = first; k < std::min(first + 4, count); ++k) {
+      std::uint32_t at = place[k - first];
+      while (row[at] != kFree) ++at;
+      row[at] = found[k];
+      touching += keys[k] < 0.0f;
+    }
+  }
+  return touching;
+}
+
+// A ball's place in the order of its batch: by the length of its list, then
+// by how many of the balls on it touch it. A group costs as many blocks as
+// its longest list, and as many with a force to compute as its most touching
+// ball's contacts (order_nearest_first puts them first). Grouping by length
+// keeps the blocks full, so the lists take no more memory than they need
+// (the step of a million balls waits on memory, not on arithmetic), and
+// within a length by contacts keeps the blocks with a force few. Counts past
+// 15 share a key: only the grouping is coarser.
+inline std::uint8_t length_contacts_key(std::uint32_t touching, std::uint32_t listed) {
+  return std::uint8_t(std::min(listed, 15u) * 16 + std::min(touching, 15u));
+}
+
+// Balls first..end-1 of a batch by their length_contacts_key (a counting sort;
+// keys[b - first] is ball b's), padded to a multiple of `lanes` with the
+// last one repeated: a repeated ball is computed twice and stored twice,
+// with the same result. Returns the length.
+inline std::uint32_t by_length_and_contacts(const std::uint8_t* keys, std::uint32_t first, std::uint32_t end,
+                                            std::uint32_t lanes, std::uint32_t* order) {
+  constexpr std::uint32_t kBuckets = 256;
   std::uint32_t start[kBuckets + 1] = {};
-  for (std::uint32_t b = first; b < end; ++b) ++start[std::min(counts[b], kBuckets - 1) + 1];
+  for (std::uint32_t b = first; b < end; ++b) ++start[keys[b - first] + 1];
   for (std::uint32_t c = 1; c <= kBuckets; ++c) start[c] += start[c - 1];
-  for (std::uint32_t b = first; b < end; ++b) order[start[std::min(counts[b], kBuckets - 1)]++] = b;
+  for (std::uint32_t b = first; b < end; ++b) order[start[keys[b - first]]++] = b;
   std::uint32_t n = end - first;
   for (; n % lanes != 0; ++n) order[n] = order[n - 1];
   return n;
@@ -87,27 +136,34 @@ inline std::uint32_t by_neighbour_count(const std::uint32_t* counts, std::uint32
 
 // The lists of balls [begin, end), laid out for groups of kLanes balls
 // (broadphase.h): each batch's lists are found into rows of a scratch buffer
-// that stays in the cache, the batch is ordered by count, and each group's
-// rows are interleaved into blocks, the ghost where a list has ended. The
-// step then reads one contiguous block per vector of neighbours, and the
-// lists take as much memory as the groups need, not a stride per ball.
+// that stays in the cache and ordered nearest first, the batch is ordered by
+// list length and contacts, and each group's rows are interleaved into
+// blocks, the ghost where a list has ended. The step then reads one
+// contiguous block per vector of neighbours, and the lists take as much
+// memory as the groups need, not a stride per ball.
 template <std::uint32_t kLanes>
 std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t end) {
-  thread_local std::vector<std::uint32_t> rows;
+  thread_local std::vector<std::uint32_t> rows, found;
+  thread_local std::vector<float> keys;
   rows.resize(std::size_t(kStepBatch) * b.stride);
+  found.resize(b.stride);
+  keys.resize(b.stride + 3);
   std::uint32_t longest = 0;
   for (std::uint32_t batch = begin, last_of_batch; batch < end; batch = last_of_batch) {
     last_of_batch = batch_end(batch, end);
     BatchReach reach;  // a local: stores to the lists cannot change it
+    std::uint8_t group_keys[kStepBatch];
     for (std::uint32_t i = batch; i < last_of_batch; ++i) {
       std::uint32_t* const row = rows.data() + std::size_t(i - batch) * b.stride;
-      b.counts[i] = list_of(b, i, row);
+      b.counts[i] = list_of(b, i, found.data(), keys.data());
       longest = std::max(longest, b.counts[i]);
-      for (std::uint32_t k = 0; k < std::min(b.counts[i], b.stride); ++k) reach.add(row[k]);
+      const std::uint32_t stored = std::min(b.counts[i], b.stride);
+      group_keys[i - batch] = length_contacts_key(order_nearest_first(keys.data(), found.data(), stored, row), stored);
+      for (std::uint32_t k = 0; k < stored; ++k) reach.add(row[k]);
     }
     b.reach[batch / kStepBatch] = reach;
     std::uint32_t* order = b.batch_order + batch;
-    const std::uint32_t grouped = by_neighbour_count(b.counts, batch, last_of_batch, kLanes, order);
+    const std::uint32_t grouped = by_length_and_contacts(group_keys, batch, last_of_batch, kLanes, order);
     std::uint32_t* block = b.neighbours + std::size_t(batch) * b.stride;
     for (const std::uint32_t* group = order; group < order + grouped; group += kLanes) {
       const std::uint32_t* row[kLanes];
@@ -164,7 +220,10 @@ template <class V>
     const V d2 = mul_add(dz, dz, mul_add(dy, dy, dx * dx));
     const V reach = rj + i.r;
     const auto touching = d2 < reach * reach;
-    // Velocities for every block: in a pile 99 % of blocks have a lane in contact.
+    // The lists are ordered nearest first at the build, and groups formed by
+    // length and then contacts: the last blocks of a group usually hold only
+    // pairs that the skin keeps, with no force to compute.
+    if (!simd::any(touching)) continue;
     V dvx, dvy, dvz, inv_mj;
     Lanes<V>::load(s.vel_half, block, dvx, dvy, dvz, inv_mj);
     dvx -= i.vx, dvy -= i.vy, dvz -= i.vz;

@@ -178,7 +178,7 @@ Layout shuffled_groups(const DenseScene& scene, std::uint32_t lanes) {
 }  // namespace
 
 TEST_CASE("a ball's step does not depend on which balls share its vector", "[physics][determinism]") {
-  // Each SIMD kernel groups balls of similar neighbour counts, one per lane;
+  // Each SIMD kernel groups balls of similar list lengths and contacts, one per lane;
   // the same lists grouped at random, and the step called on chunks of
   // batches as the worker threads call it, must give every ball the same bits.
   std::vector<const Kernels*> simd{&kSseKernels};

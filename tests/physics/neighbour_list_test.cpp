@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <cstring>
 #include <random>
 
@@ -18,6 +19,7 @@ namespace {
 struct Lists {
   std::vector<std::uint32_t> counts;
   std::vector<std::vector<std::uint32_t>> entries;  // the stored part of each list
+  AlignedVector<Float4> pos;                        // the balls in the sorted order entries index
   std::uint32_t longest = 0;
 };
 
@@ -49,6 +51,7 @@ Lists build(const Kernels& kernels, const TankBounds& tank, const AlignedVector<
   for (std::uint32_t k = 0; k < n; ++k) pos[k] = unsorted[order[k]];
   list.reserve(n, stride, kernels.list_lanes);
   Lists out;
+  out.pos = pos;
   out.longest = kernels.build_lists(list.build_view(pos.data(), n), 0, n);
   out.counts.assign(list.counts(), list.counts() + n);
   out.entries.resize(n);
@@ -57,8 +60,20 @@ Lists build(const Kernels& kernels, const TankBounds& tank, const AlignedVector<
     ++seen[i];
     for (std::uint32_t k = 0; k < l.count; ++k) out.entries[i].push_back(l[k]);
   });
-  // The layout holds each ball's list exactly once.
+  // The layout holds each ball's list exactly once, nearest first by
+  // d^2 - (r_i + r_j)^2 (order_nearest_first).
   REQUIRE(std::count(seen.begin(), seen.end(), 1) == std::ptrdiff_t(n));
+  for (std::uint32_t i = 0; i < n; ++i) {
+    auto nearness = [&](std::uint32_t j) {
+      const float dx = pos[j].x - pos[i].x, dy = pos[j].y - pos[i].y, dz = pos[j].z - pos[i].z;
+      const float reach = pos[i].w + pos[j].w;
+      return dx * dx + dy * dy + dz * dz - reach * reach;
+    };
+    const std::vector<std::uint32_t>& l = out.entries[i];
+    INFO("ball " << i);
+    REQUIRE(std::is_sorted(l.begin(), l.end(),
+                           [&](std::uint32_t a, std::uint32_t b) { return nearness(a) < nearness(b); }));
+  }
   // Each batch's reach is the lowest and the highest ball its lists name
   // (the threaded builds say: only they have chunk edges to look after).
   for (std::uint32_t batch = 0; kernels.threaded && batch * kStepBatch < n; ++batch) {
@@ -142,7 +157,7 @@ TEST_CASE("every list build finds the same neighbours as a brute-force search", 
   }
 }
 
-TEST_CASE("a list longer than the stride is counted in full and keeps its first entries", "[physics][broadphase]") {
+TEST_CASE("a list longer than the stride is counted in full and keeps stride of its entries", "[physics][broadphase]") {
   TankBounds tank;
   tank.min = {-10.0f, 0.0f, -10.0f};
   tank.max = {10.0f, 20.0f, 10.0f};
@@ -154,10 +169,57 @@ TEST_CASE("a list longer than the stride is counted in full and keeps its first 
     const Lists cut = build(kernels_named(name), tank, balls, n, 8);
     CHECK(cut.longest == full.longest);
     CHECK(cut.counts == full.counts);
+    std::size_t shortened = 0;
     for (std::uint32_t i = 0; i < n; ++i) {
-      // The stored part is the first entries of the full list.
+      // The stored part is as long as the stride allows, and all of it from the full list.
       const std::vector<std::uint32_t>& f = full.entries[i];
-      REQUIRE(cut.entries[i] == std::vector<std::uint32_t>(f.begin(), f.begin() + std::min<std::size_t>(f.size(), 8)));
+      std::vector<std::uint32_t> kept = cut.entries[i], all = f;
+      REQUIRE(kept.size() == std::min<std::size_t>(f.size(), 8));
+      std::sort(kept.begin(), kept.end());
+      std::sort(all.begin(), all.end());
+      REQUIRE(std::includes(all.begin(), all.end(), kept.begin(), kept.end()));
+      shortened += f.size() > 8;
     }
+    CHECK(shortened > n / 10);  // the case this test is for
+  }
+}
+
+TEST_CASE("neighbours at equal distances are all kept, in the order found", "[physics][broadphase]") {
+  // Unit balls on a cubic lattice of unit spacing, at whole and half
+  // coordinates so every distance is exact: each inner ball's six nearest
+  // neighbours share one key, d^2 - (r_i + r_j)^2 = 0, and the diagonal ones
+  // (d = 1.41) are beyond the reach of 1.2. The orderings give equal keys
+  // one place each, in the order the build found them.
+  TankBounds tank;
+  tank.min = {-10.0f, 0.0f, -10.0f};
+  tank.max = {10.0f, 20.0f, 10.0f};
+  constexpr int kSide = 10;
+  const std::uint32_t n = kSide * kSide * kSide;
+  AlignedVector<Float4> balls(n + kGhostSlots, kGhostPos);
+  for (int a = 0; a < kSide; ++a)
+    for (int b = 0; b < kSide; ++b)
+      for (int c = 0; c < kSide; ++c)
+        balls[(a * kSide + b) * kSide + c] = {-4.5f + float(a), 0.5f + float(b), -4.5f + float(c), 0.5f};
+  const Lists scalar = build(kScalarKernels, tank, balls, n, 32);
+  const AlignedVector<Float4>& pos = scalar.pos;
+  std::size_t six = 0;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    std::vector<std::uint32_t> expected;  // one unit away along one axis
+    for (std::uint32_t j = 0; j < n; ++j)
+      if (std::abs(pos[j].x - pos[i].x) + std::abs(pos[j].y - pos[i].y) + std::abs(pos[j].z - pos[i].z) == 1.0f)
+        expected.push_back(j);
+    std::vector<std::uint32_t> got = scalar.entries[i];
+    std::sort(got.begin(), got.end());
+    INFO("ball " << i);
+    REQUIRE(got == expected);
+    six += got.size() == 6;
+  }
+  CHECK(six == (kSide - 2) * (kSide - 2) * (kSide - 2));  // the inner balls
+
+  for (const std::string& name : variant_names()) {
+    INFO(name);
+    const Lists simd = build(kernels_named(name), tank, balls, n, 32);
+    CHECK(simd.counts == scalar.counts);
+    CHECK(simd.entries == scalar.entries);
   }
 }
