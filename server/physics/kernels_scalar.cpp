@@ -129,8 +129,8 @@ void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std:
 // while the pair touches and grows with the gap between the surfaces. Every
 // twin's build orders its lists so (kernels_simd_ball.h has the SIMD one),
 // and each ball sums its forces in the same order in all of them; a SIMD step
-// skips the force of a block in which no lane touches, which in this order
-// are a group's last blocks, the pairs only the skin keeps. Each entry's
+// skips the force of a block in which no lane touches, and in this order such
+// blocks are a group's last, holding pairs only the skin keeps. Each entry's
 // place is the number of entries before it in the order.
 void order_nearest_first(const float* keys, const std::uint32_t* found, std::uint32_t count, std::uint32_t* list) {
   for (std::uint32_t k = 0; k < count; ++k) {
