@@ -70,19 +70,26 @@ void NeighbourList::reserve(std::uint32_t n, std::uint32_t stride, std::uint32_t
   }
 }
 
-ListBuild NeighbourList::grid_view() const {
-  ListBuild grid{};
-  grid.cell_start = cell_start_.data();
-  grid.nx = nx_, grid.ny = ny_, grid.nz = nz_, grid.block = block_;
-  grid.origin = tank_.min, grid.edge = edge_, grid.skin = skin_;
-  return grid;
+bool NeighbourList::can_check(float moved) const {
+  const float reach = kMaxBallDiameter + moved;  // a large ball's
+  return reach <= kMaxCheckCells * std::min({edge_.x, edge_.y, edge_.z});
 }
 
-bool NeighbourList::can_check(float radius, float moved) const {
-  // Past the skin, a margin for the rounding of the cells' assignment (sort()).
-  constexpr float kCellMargin = 0.01f;
-  const float reach = radius + 0.5f * kMaxBallDiameter + moved;
-  return moved <= skin_ || reach + kCellMargin <= std::min({edge_.x, edge_.y, edge_.z});
+template <class Visit>
+void NeighbourList::for_each_range_in_box(const Float4& p, float reach, Visit visit) const {
+  // The margin covers the rounding of the cells' assignment (sort()): cell_of
+  // rounds monotonically, so a ball within reach is in a cell between these.
+  const float wide = reach * 1.001f + 1e-3f;
+  const CellCoord lo = cell_of({p.x - wide, p.y - wide, p.z - wide, 0.0f});
+  const CellCoord hi = cell_of({p.x + wide, p.y + wide, p.z + wide, 0.0f});
+  for (int z = lo.z; z <= hi.z; ++z)
+    for (int y = lo.y; y <= hi.y; ++y)
+      for (int x = lo.x; x <= hi.x;) {  // a row's cells are one range per block
+        const int last = std::min(hi.x, (x / block_ + 1) * block_ - 1);
+        visit(cell_start_[cell_number(x, y, z, ny_, nz_, block_)],
+              cell_start_[cell_number(last, y, z, ny_, nz_, block_) + 1]);
+        x = last + 1;
+      }
 }
 
 bool NeighbourList::misses_contact(std::uint32_t i, const Float4* pos, const Float4* at_build, float moved) const {
@@ -91,11 +98,11 @@ bool NeighbourList::misses_contact(std::uint32_t i, const Float4* pos, const Flo
   // clearly inside the build's cutoff.
   constexpr float kTouchMargin = 1.0f + 1e-5f, kListedMargin = 1.0f - 1e-5f;
   const Float4 p = pos[i], b = at_build[i];
-  if (!can_check(p.w, moved)) return true;
-  ListBuild grid = grid_view();
-  grid.skin = std::max(skin_, moved);  // the search's reach: r_i + the largest radius + this
+  if (!can_check(moved)) return true;
+  // A ball touching i now was at the build within r_i + r_j + moved of p.
+  const float reach = p.w + 0.5f * kMaxBallDiameter + moved;
   bool missing = false;
-  for_each_range_within_reach(grid, cell_of(p), p, [&](std::uint32_t j_begin, std::uint32_t j_end) {
+  for_each_range_in_box(p, reach, [&](std::uint32_t j_begin, std::uint32_t j_end) {
     for (std::uint32_t j = j_begin; j < j_end && !missing; ++j) {
       const Float4 q = pos[j], qb = at_build[j];
       const float dx = p.x - q.x, dy = p.y - q.y, dz = p.z - q.z, touch = p.w + q.w;
@@ -123,7 +130,10 @@ ListBuild NeighbourList::build_view(const Float4* pos, std::uint32_t n) {
       r[k] = pos[k].w;
     }
   }
-  ListBuild b = grid_view();
+  ListBuild b{};
+  b.cell_start = cell_start_.data();
+  b.nx = nx_, b.ny = ny_, b.nz = nz_, b.block = block_;
+  b.origin = tank_.min, b.edge = edge_, b.skin = skin_;
   b.pos = pos, b.n = n, b.ball_cell = sorted_cell_.data();
   b.x = x, b.y = y, b.z = z, b.r = r;
   b.neighbours = neighbours_.get(), b.counts = counts_.data(), b.stride = stride_;

@@ -19,8 +19,8 @@
 // build (two balls closing by skin / 2 each could then touch unseen), the
 // LAMMPS criterion. Past that the world keeps it as long as the few balls
 // that moved further touch only balls in their lists (misses_contact, for as
-// long as its search reaches: can_check): in a million-ball scene the fastest
-// balls are a thin tail, and most rebuilds were for them alone.
+// long as a search is worth it: can_check): in a million-ball scene the
+// fastest balls are a thin tail, and most rebuilds were for them alone.
 
 #include <algorithm>
 #include <cstddef>
@@ -231,16 +231,17 @@ class NeighbourList {
   // whose position at the last build (at_build) was beyond the list's reach.
   // `moved` is the furthest any ball has moved since that build: a ball that
   // touches i now was then within r_i + the largest radius + moved of where i
-  // is now, and the search covers the cells around i's up to that distance.
-  // The world checks this for the few balls that moved more than skin / 2
-  // instead of rebuilding for them (world.cpp, lists_hold()). Also true when
-  // the search cannot tell (can_check).
+  // is now, and the search covers the build's cells that far around it, as
+  // many as that takes. The world checks this for the few balls that moved
+  // more than skin / 2 instead of rebuilding for them (world.cpp,
+  // lists_hold()). Also true past can_check.
   bool misses_contact(std::uint32_t i, const Float4* pos, const Float4* at_build, float moved) const;
-  // Whether misses_contact can vouch for a ball of this radius after balls
-  // moved up to `moved`: always up to the skin (cells are the largest diameter
-  // + skin wide), beyond it while r + the largest radius + moved still fits
-  // in a cell, so that the cells around the ball's hold every ball it can touch.
-  bool can_check(float radius, float moved) const;
+  // Whether a check after balls moved up to `moved` is worth it: while a large
+  // ball's search reaches at most kMaxCheckCells cells past its own on every
+  // side, so that a check costs a few list builds' candidates at most, not a
+  // box of cells growing with the cube of the distance.
+  bool can_check(float moved) const;
+  static constexpr int kMaxCheckCells = 2;
 
   // Room for `stride` neighbours of each of n balls, laid out in groups of
   // `lanes` (Kernels::list_lanes of the build that fills them).
@@ -261,8 +262,10 @@ class NeighbourList {
 
  private:
   CellCoord cell_of(const Float4& p) const;
-  // A ListBuild with only the grid filled in: what for_each_range_within_reach reads.
-  ListBuild grid_view() const;
+  // Calls visit(j_begin, j_end) for index ranges that hold every ball of the
+  // last build whose position lies within `reach` of p on every axis.
+  template <class Visit>
+  void for_each_range_in_box(const Float4& p, float reach, Visit visit) const;
 
   TankBounds tank_;
   float skin_ = 0.0f;

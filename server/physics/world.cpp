@@ -215,6 +215,8 @@ void World::rebuild() {
   }
   needs_rebuild_ = false;
   ++rebuilds_;
+  steps_since_build_ = 0;
+  checks_since_build_ = 0;
 }
 
 // From this many balls the step pass's arrays (about 140 bytes per ball)
@@ -336,21 +338,27 @@ bool World::lists_hold() {
   // Two balls that each moved at most skin / 2 since the build cannot have
   // closed the skin between them unseen. Past that the lists are kept while
   // every ball that moved further (a few fast ones, the step pass lists them)
-  // touches only balls in its list, checked one by one for as long as the
-  // check's search reaches (NeighbourList::can_check: for a small ball, until
-  // the fastest has moved about six skins). Beyond a few such balls a rebuild
-  // is cheaper.
+  // touches only balls in its list, checked one by one while a check is
+  // worth it (NeighbourList::can_check: until the fastest has moved about a
+  // cell's width), and while checking costs less than rebuilding (below).
   if (next_max_d2_ <= half_skin_d2()) return true;
   if (!far_listed_ || !std::isfinite(next_max_d2_)) return false;
   const float moved = std::sqrt(next_max_d2_);
-  if (!list_.can_check(0.5f * kMinBallDiameter, moved)) return false;  // not even for the smallest ball
+  if (!list_.can_check(moved)) return false;
   // Each chunk listed its far balls from its begin: gather them to the front.
   std::uint32_t far = 0;
   for (const ChunkMoved& chunk : thread_moved_) {
     std::copy_n(far_balls_.begin() + chunk.begin, chunk.moved.far, far_balls_.begin() + far);
     far += chunk.moved.far;
   }
-  if (far > n_ / kFarBallsPerCheck + 16) return false;
+  // Far balls grow in number with the time since the build, and so does the
+  // cost of checking them: the lists are kept while this step's checks cost
+  // less than the mean cost per step since the build, the rebuild counted in
+  // (in checks, not seconds, so that the choice is the same for any thread
+  // count), and while the step checks few balls.
+  const double cycle_cost = kRebuildCostInChecksPerBall * n_ + double(checks_since_build_);
+  if (double(far) * steps_since_build_ >= cycle_cost || far > n_ / kFarBallsPerCheck + 16) return false;
+  checks_since_build_ += far;
   PhaseTimer timer(phase_seconds_.neighbours);
   std::fill(thread_missing_.begin(), thread_missing_.end(), 0);
   // A check costs about as much as a hundred balls' steps: a few are worth a thread.
@@ -387,6 +395,7 @@ void World::step() {
   next_max_d2_ = 0.0f;
   for (const ChunkMoved& chunk : thread_moved_) next_max_d2_ = std::max(next_max_d2_, chunk.moved.max_d2);
   far_listed_ = true;
+  ++steps_since_build_;
   vel_stale_ = true;
   time_ += model_.dt;
   ++steps_;

@@ -94,6 +94,13 @@ TEST_CASE("two balls closing head-on from beyond the skin get a rebuild before t
   INFO(variant);
   const PhysicsParams params = open_space();
   World world(params, kernels_named(variant), 1, 3);
+  // A thousand resting balls well away from the pairs: for a dozen balls
+  // alone a rebuild costs less than checking even one (World::lists_hold),
+  // and the check is what this test is about.
+  for (int x = 0; x < 10; ++x)
+    for (int y = 0; y < 10; ++y)
+      for (int z = 0; z < 10; ++z)
+        world.place_ball(0, {-45.0f + 1.5f * x, 5.0f + 1.5f * y, -45.0f + 1.5f * z}, {0.0f, 0.0f, 0.0f});
   const float extras[] = {0.1f, 0.2f, 0.3f}, slower[] = {20.0f, 8.0f};
   for (int pair = 0; pair < 6; ++pair) {
     const float gap = 1.0f + params.skin * (1.0f + extras[pair % 3]);  // centres: two radii 0.5, the skin and more
@@ -127,14 +134,44 @@ TEST_CASE("the check finds a contact between two balls that both moved well past
   list.sort(at_build.data(), 2, order);
   REQUIRE(order == std::vector<std::uint32_t>{0, 1});  // a's cell comes first: indices stay
 
-  REQUIRE(list.can_check(0.5f, moved));
+  REQUIRE(list.can_check(moved));
   CHECK(list.misses_contact(0, now.data(), at_build.data(), moved));
   // Apart again, nothing is missing.
   now[1].x += 0.1f;
   CHECK_FALSE(list.misses_contact(0, now.data(), at_build.data(), moved));
-  // Beyond what a cell holds the check cannot tell, and says so.
-  CHECK_FALSE(list.can_check(0.5f, 1.4f));
-  CHECK(list.can_check(1.5f, 0.3f));
-  CHECK_FALSE(list.can_check(1.5f, 0.35f));
-  CHECK(list.misses_contact(0, now.data(), at_build.data(), 1.4f));
+}
+
+TEST_CASE("the check finds a contact between two large balls whose build positions lie two cells apart",
+          "[physics][broadphase]") {
+  // Two large balls (radius 1.5), 4.9 apart at the build, each moved 1.0
+  // towards the other and now touch. From where ball a is now, b's position
+  // at the build lies 3.9 away, in the second cell along x from a's: the 27
+  // cells around a's do not hold it (until the check searched as many cells
+  // as its reach takes, it could not vouch for a large ball once balls had
+  // moved ~0.3, and the lists were rebuilt). Past a large ball's search of two
+  // cells each side, the check does not search and answers "missing".
+  TankBounds tank;  // 40 units, 12 cells of 3.33 per axis
+  const float edge = tank.size().x / 12.0f, face = tank.min.x + 7.0f * edge, moved = 1.0f;
+  const Float4 a_now{face - 0.3f, 21.5f, 1.5f, 1.5f}, b_now{a_now.x + 2.9f, 21.5f, 1.5f, 1.5f};
+  const Float4 a_build{a_now.x - moved, 21.5f, 1.5f, 1.5f}, b_build{a_now.x + 3.9f, 21.5f, 1.5f, 1.5f};
+  REQUIRE(b_build.x > face + edge);  // two cells on from a's
+
+  NeighbourList list;
+  list.configure(tank, 0.2f);
+  AlignedVector<Float4> at_build{a_build, b_build}, now{a_now, b_now};
+  for (std::uint32_t g = 0; g < kGhostSlots; ++g) at_build.push_back(kGhostPos), now.push_back(kGhostPos);
+  std::vector<std::uint32_t> order;
+  list.sort(at_build.data(), 2, order);
+  REQUIRE(order == std::vector<std::uint32_t>{0, 1});
+
+  REQUIRE(list.can_check(moved));
+  CHECK(list.misses_contact(0, now.data(), at_build.data(), moved));
+  CHECK(list.misses_contact(1, now.data(), at_build.data(), moved));  // and from b's side
+  now[1].x += 0.2f;                                                   // apart again
+  CHECK_FALSE(list.misses_contact(0, now.data(), at_build.data(), moved));
+  CHECK_FALSE(list.misses_contact(1, now.data(), at_build.data(), moved));
+  // The limit: the largest diameter + moved within two cells' width.
+  CHECK(list.can_check(2.0f * edge - kMaxBallDiameter - 0.01f));
+  CHECK_FALSE(list.can_check(2.0f * edge - kMaxBallDiameter + 0.01f));
+  CHECK(list.misses_contact(0, now.data(), at_build.data(), 2.0f * edge - kMaxBallDiameter + 0.01f));
 }
