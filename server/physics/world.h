@@ -193,8 +193,8 @@ class World {
   // (measured: 474-505 us per step against 669-738 without this bound, the
   // same 40 rebuilds per 1000 steps).
   static constexpr std::uint32_t kFarBallsPerCheck = 256;
-  // Far balls' checks per thread at least: a check costs about a hundred
-  // balls' steps, so from 8 checks two threads share them (measured within
+  // Far balls' checks per thread at least: a check costs a few dozen balls'
+  // steps, so from 8 checks two threads share them (measured within
   // this machine's noise: +1.4, -1.5 and +1.5 % of a settled tank's step).
   static constexpr std::uint32_t kFarChecksPerThread = 4;
   static constexpr float kFarMargin = 1.0f - 1e-5f;  // a ball right at skin / 2 counts as far
