@@ -52,6 +52,25 @@ std::size_t step_checking_lists(World& world, int steps) {
   return contacts;
 }
 
+// Balls a and b (and the ghosts after them) at their positions at a build
+// and now, with the grid of that build in the default 40-unit tank (12 cells
+// of 3.33 per axis) and the default skin.
+struct TwoBalls {
+  NeighbourList list;
+  AlignedVector<Float4> at_build, now;
+};
+TwoBalls two_balls(Float4 a_build, Float4 b_build, Float4 a_now, Float4 b_now) {
+  TwoBalls t;
+  t.list.configure(TankBounds{}, PhysicsParams{}.skin);
+  t.at_build = {a_build, b_build};
+  t.now = {a_now, b_now};
+  for (std::uint32_t g = 0; g < kGhostSlots; ++g) t.at_build.push_back(kGhostPos), t.now.push_back(kGhostPos);
+  std::vector<std::uint32_t> order;
+  t.list.sort(t.at_build.data(), 2, order);
+  REQUIRE(order == std::vector<std::uint32_t>{0, 1});  // a's cell comes first: indices stay
+  return t;
+}
+
 }  // namespace
 
 TEST_CASE("the lists hold every touching pair at every step while fast balls fly into a pile",
@@ -125,14 +144,7 @@ TEST_CASE("the check finds a contact between two balls that both moved well past
   const float face = tank.min.x + 8.0f * tank.size().x / 12.0f, moved = 1.25f;
   const Float4 a_now{face - 2.23f, 21.5f, 1.5f, 0.5f}, b_now{a_now.x + 1.0f, 21.5f, 1.5f, 0.5f};
   const Float4 a_build{a_now.x - moved, 21.5f, 1.5f, 0.5f}, b_build{a_now.x + 2.25f, 21.5f, 1.5f, 0.5f};
-
-  NeighbourList list;
-  list.configure(tank, 0.2f);
-  AlignedVector<Float4> at_build{a_build, b_build}, now{a_now, b_now};
-  for (std::uint32_t g = 0; g < kGhostSlots; ++g) at_build.push_back(kGhostPos), now.push_back(kGhostPos);
-  std::vector<std::uint32_t> order;
-  list.sort(at_build.data(), 2, order);
-  REQUIRE(order == std::vector<std::uint32_t>{0, 1});  // a's cell comes first: indices stay
+  auto [list, at_build, now] = two_balls(a_build, b_build, a_now, b_now);
 
   REQUIRE(list.can_check(moved));
   CHECK(list.misses_contact(0, now.data(), at_build.data(), moved));
@@ -155,14 +167,7 @@ TEST_CASE("the check finds a contact between two large balls whose build positio
   const Float4 a_now{face - 0.3f, 21.5f, 1.5f, 1.5f}, b_now{a_now.x + 2.9f, 21.5f, 1.5f, 1.5f};
   const Float4 a_build{a_now.x - moved, 21.5f, 1.5f, 1.5f}, b_build{a_now.x + 3.9f, 21.5f, 1.5f, 1.5f};
   REQUIRE(b_build.x > face + edge);  // two cells on from a's
-
-  NeighbourList list;
-  list.configure(tank, 0.2f);
-  AlignedVector<Float4> at_build{a_build, b_build}, now{a_now, b_now};
-  for (std::uint32_t g = 0; g < kGhostSlots; ++g) at_build.push_back(kGhostPos), now.push_back(kGhostPos);
-  std::vector<std::uint32_t> order;
-  list.sort(at_build.data(), 2, order);
-  REQUIRE(order == std::vector<std::uint32_t>{0, 1});
+  auto [list, at_build, now] = two_balls(a_build, b_build, a_now, b_now);
 
   REQUIRE(list.can_check(moved));
   CHECK(list.misses_contact(0, now.data(), at_build.data(), moved));
