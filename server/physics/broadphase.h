@@ -241,7 +241,6 @@ class NeighbourList {
   // side, so that a check costs a few list builds' candidates at most, not a
   // box of cells growing with the cube of the distance.
   bool can_check(float moved) const;
-  static constexpr int kMaxCheckCells = 2;
 
   // Room for `stride` neighbours of each of n balls, laid out in groups of
   // `lanes` (Kernels::list_lanes of the build that fills them).
@@ -266,6 +265,8 @@ class NeighbourList {
   // last build whose position lies within `reach` of p on every axis.
   template <class Visit>
   void for_each_range_in_box(const Float4& p, float reach, Visit visit) const;
+
+  static constexpr int kMaxCheckCells = 2;  // see can_check
 
   TankBounds tank_;
   float skin_ = 0.0f;

@@ -215,8 +215,8 @@ void World::rebuild() {
   }
   needs_rebuild_ = false;
   ++rebuilds_;
-  steps_since_build_ = 0;
-  checks_since_build_ = 0;
+  built_at_step_ = steps_;
+  far_checked_at_build_ = far_checked_;
 }
 
 // From this many balls the step pass's arrays (about 140 bytes per ball)
@@ -356,10 +356,11 @@ bool World::lists_hold() {
   // less than the mean cost per step since the build, the rebuild counted in
   // (in checks, not seconds, so that the choice is the same for any thread
   // count), and while the step checks few balls.
-  const double cycle_cost = kRebuildCostInChecksPerBall * n_ + double(checks_since_build_);
-  if (double(far) * steps_since_build_ >= cycle_cost || far > n_ / kFarBallsPerCheck + 16) return false;
-  checks_since_build_ += far;
-  PhaseTimer timer(phase_seconds_.neighbours);
+  const double cycle_cost = kRebuildCostInChecksPerBall * n_ + double(far_checked_ - far_checked_at_build_);
+  const double steps_since_build = double(steps_ - built_at_step_);
+  if (double(far) * steps_since_build >= cycle_cost || far > n_ / kFarBallsPerCheck + 16) return false;
+  far_checked_ += far;
+  PhaseTimer timer(phase_seconds_.neighbours), check_timer(phase_seconds_.far_checks);
   std::fill(thread_missing_.begin(), thread_missing_.end(), 0);
   // A check costs a few dozen balls' steps (0.2-0.5 us): a few are worth a thread.
   pool_.run_costly(far, kFarChecksPerThread, [&](std::uint32_t begin, std::uint32_t end, int thread) {
@@ -395,7 +396,6 @@ void World::step() {
   next_max_d2_ = 0.0f;
   for (const ChunkMoved& chunk : thread_moved_) next_max_d2_ = std::max(next_max_d2_, chunk.moved.max_d2);
   far_listed_ = true;
-  ++steps_since_build_;
   vel_stale_ = true;
   time_ += model_.dt;
   ++steps_;

@@ -40,6 +40,7 @@ struct PhaseSeconds {
   double spawn = 0.0;
   double neighbours = 0.0;  // sort, reorder and list build, and checks that keep the lists
   double step_pass = 0.0;   // forces and integration
+  double far_checks = 0.0;  // the part of neighbours that checks the far balls (World::lists_hold)
 };
 
 struct AddResult {
@@ -91,6 +92,8 @@ class World {
   // Steps whose lists were kept after checking the balls that had moved more
   // than skin / 2 since the build (lists_hold()).
   std::uint64_t lists_kept_far() const { return lists_kept_far_; }
+  // Balls checked in those steps and in the steps whose checks found a contact.
+  std::uint64_t far_balls_checked() const { return far_checked_; }
   // The lists of the last build, for tests and tools.
   const NeighbourList& neighbour_list() const { return list_; }
   float dt() const { return model_.dt; }
@@ -182,16 +185,17 @@ class World {
   std::uint32_t capacity_;
   std::uint32_t max_balls_;
   // A far ball's check costs what rebuilding the lists costs per two balls
-  // (measured: 0.29 us a check against 150 ns a ball's share of a rebuild in
-  // the settled tank on two threads; 0.22 us against 137 ns with 10 000 balls
-  // of the wide scene, 0.48 us against 129 ns with a million).
+  // (on two threads: 0.26 us a check against 132 ns a ball's share of a
+  // rebuild in the settled tank, 0.29 us against 152 ns with 10 000 balls of
+  // the wide scene, 0.56 us against 148 ns with a million; the step benchmarks'
+  // check_us_per_step, far_per_step and rebuild_us, fishtank-bench-variants).
   static constexpr double kRebuildCostInChecksPerBall = 0.5;
   // Past n / kFarBallsPerCheck (+ 16) far balls the lists are rebuilt
   // whatever the checks cost so far: in the wide scene's million, checks go
   // on finding nothing well past that count, only to end in a contact the
   // lists lack a few steps later, with half again the checks per step
-  // (measured: 474-505 us per step against 669-738 without this bound, the
-  // same 40 rebuilds per 1000 steps).
+  // (measured in a build without this bound: 669-738 us of checks per step
+  // against 474-505, the same 40 rebuilds per 1000 steps).
   static constexpr std::uint32_t kFarBallsPerCheck = 256;
   // Far balls' checks per thread at least: a check costs a few dozen balls'
   // steps, so from 8 checks two threads share them (measured within
@@ -215,8 +219,8 @@ class World {
   std::uint64_t steps_ = 0;
   std::uint64_t rebuilds_ = 0;
   std::uint64_t lists_kept_far_ = 0;
-  std::uint64_t steps_since_build_ = 0;
-  std::uint64_t checks_since_build_ = 0;  // far balls checked
+  std::uint64_t far_checked_ = 0;
+  std::uint64_t built_at_step_ = 0, far_checked_at_build_ = 0;  // steps_ and far_checked_ at the last build
   PhaseSeconds phase_seconds_;
 };
 
