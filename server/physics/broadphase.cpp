@@ -1,7 +1,6 @@
 #include "server/physics/broadphase.h"
 
 #include <algorithm>
-#include <cmath>
 
 namespace fishtank {
 
@@ -21,11 +20,13 @@ void NeighbourList::configure(const TankBounds& tank, float skin) {
 }
 
 CellCoord NeighbourList::cell_of(const Float4& p) const {
-  // fmin/fmax also send NaN to a valid cell; balls pushed outside the tank go
-  // to the border cell, which still finds all their neighbours.
+  // Clamped before the conversion, which then rounds down: balls pushed
+  // outside the tank go to the border cell, which still finds all their
+  // neighbours, and NaN fails the first comparison and goes to cell 0.
+  // Comparisons, not std::fmax and std::fmin, which this build calls in libm.
   auto axis = [](float pos, float lo, float inv_edge, int cells) {
-    float c = std::floor((pos - lo) * inv_edge);
-    return static_cast<std::int32_t>(std::fmin(std::fmax(c, 0.0f), float(cells - 1)));
+    const float c = std::max(0.0f, (pos - lo) * inv_edge);
+    return static_cast<std::int32_t>(std::min(c, float(cells - 1)));
   };
   return {axis(p.x, tank_.min.x, inv_edge_.x, nx_), axis(p.y, tank_.min.y, inv_edge_.y, ny_),
           axis(p.z, tank_.min.z, inv_edge_.z, nz_)};
@@ -44,9 +45,9 @@ void NeighbourList::sort(const Float4* pos, std::uint32_t n, std::vector<std::ui
 
   order.resize(n);
   sorted_cell_.resize(n);
-  std::vector<std::uint32_t> next(cell_start_.begin(), cell_start_.end() - 1);
+  next_slot_.assign(cell_start_.begin(), cell_start_.end() - 1);
   for (std::uint32_t i = 0; i < n; ++i) {
-    std::uint32_t slot = next[scratch_number_[i]]++;
+    std::uint32_t slot = next_slot_[scratch_number_[i]]++;
     order[slot] = i;
     sorted_cell_[slot] = scratch_cell_[i];
   }

@@ -277,6 +277,7 @@ class NeighbourList {
   std::vector<CellCoord> sorted_cell_;     // per sorted ball, its cell
   std::vector<CellCoord> scratch_cell_;
   std::vector<std::uint32_t> scratch_number_;
+  std::vector<std::uint32_t> next_slot_;  // per cell number, the sort's next free slot
   std::uint32_t stride_ = 0;
   std::uint32_t lanes_ = 1;
   std::uint32_t listed_balls_ = 0;  // n of the last build_view
