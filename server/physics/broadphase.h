@@ -106,6 +106,26 @@ struct BatchReach {
   }
 };
 
+// The rows a batch's lists name far from the batch in the sorted order: in
+// practice the neighbours across a column block's x faces (sort() above), a
+// whole block of balls away, where neither the rows that the SIMD step asks
+// for ahead nor those it read lately lie (kernels_simd_ball.h, is_far_row).
+// One row per cache line of rows, up to kMost: a batch that names more keeps
+// the first kMost, and the rest are only asked for late, never wrong. The
+// SIMD builds write them and the SIMD steps ask for them ahead.
+struct FarRows {
+  static constexpr std::uint32_t kMost = 31;
+  static constexpr std::uint32_t kRowsPerLine = 64 / sizeof(Float4);
+  std::uint32_t count = 0;
+  std::uint32_t rows[kMost];  // the first row of each line
+
+  void add(std::uint32_t row) {
+    const std::uint32_t line_row = row - row % kRowsPerLine;
+    if (count == kMost || std::find(rows, rows + count, line_row) != rows + count) return;
+    rows[count++] = line_row;
+  }
+};
+
 // What a list build reads and writes: the cell-sorted balls and the grid, and
 // the lists to fill. The build itself is a kernel (kernels.h), scalar or SIMD.
 struct CellCoord {
@@ -132,6 +152,7 @@ struct ListBuild {
   BatchReach* reach;             // out, threaded builds only: per batch, the balls its stored lists name
   std::uint32_t* group_records;  // out, SIMD builds only: per group, its record (see above)
   std::uint32_t* group_blocks;   // out, SIMD builds only: per group, its number of blocks
+  FarRows* far_rows;             // out, SIMD builds only, unless null: per batch, its far rows
 };
 
 // One ball's stored list: neighbour k is listed_index(first[k * lanes]).
@@ -253,6 +274,7 @@ class NeighbourList {
   const BatchReach* batch_reach() const { return reach_.data(); }
   const std::uint32_t* group_records() const { return group_records_.data(); }
   const std::uint32_t* group_blocks() const { return group_blocks_.data(); }
+  const FarRows* far_rows() const { return far_rows_.data(); }
 
   // Calls visit(i, ListView) once for each ball of the last build, batch by
   // batch in the layout's order.
@@ -291,6 +313,7 @@ class NeighbourList {
   std::vector<BatchReach> reach_;
   AlignedVector<std::uint32_t> group_records_;  // SIMD builds only
   std::vector<std::uint32_t> group_blocks_;     // SIMD builds only
+  std::vector<FarRows> far_rows_;               // SIMD builds only
   AlignedVector<float> axes_;                   // x, y, z, radius of the sorted balls, axis by axis (ListBuild)
 };
 

@@ -61,6 +61,11 @@ struct StepArrays {
   // Whether the arrays outgrow the caches, so that the SIMD kernels ask for
   // rows a few batches ahead (kernels_simd_ball.h, prefetch_batch_ahead).
   bool beyond_cache = false;
+  // Per batch of balls (numbered by ball / kStepBatch, `batches` of them),
+  // the rows its lists name far away (broadphase.h), which the SIMD steps ask
+  // for ahead too when beyond_cache; the scalar twin ignores them.
+  const FarRows* far_rows = nullptr;
+  std::uint32_t batches = 0;
   // A ball whose pos_next is further than sqrt(far_d2) from pos_at_build is
   // "far": the step of chunk [begin, end) lists its far balls, each once, at
   // far_balls + begin, for the world to check them one by one

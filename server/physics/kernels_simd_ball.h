@@ -133,6 +133,35 @@ inline std::uint32_t by_length_and_contacts(const std::uint8_t* keys, std::uint3
   return n;
 }
 
+// Beyond the caches (the wide scene from 100 000 balls) a batch's rows arrive
+// late if left to the hardware, which sees them gathered and scattered in the
+// order of the groups, not of the addresses. So each group asks for its share
+// of the rows and lists of the batch kPrefetchBatches ahead: share is the
+// group's place in its batch. At 1 000 000 balls asking one batch ahead took
+// the step pass from 28.7 to 23.7 ns per ball-step, and four ahead (~60 KB of
+// rows and lists, a few microseconds of work) from 16.0-19.2 to 11.3-12.1
+// against one: one batch's ~2 us did not cover the memory's latency under two
+// threads' misses. From cache it changes nothing measurable, and it costs 3 %
+// more instructions, so the world asks for it only for piles larger than the
+// caches (StepArrays::beyond_cache; technical report, 6.2).
+constexpr std::uint32_t kPrefetchBatches = 4;
+
+// The rows of a batch's lists that the step has asked for or read lately
+// when it reaches the batch: those of the kPrefetchBatches batches from it,
+// and those of the 16 batches before it, still in the second-level cache
+// (~290 KB at the ~140 bytes a ball-step moves, of 1 MB). Any other is a far
+// row (broadphase.h, FarRows), asked for with the batch's own rows. In the
+// wide scene's million, 6.9 % of the balls have neighbours across a block's
+// face, 60 000 balls away: 0.09 far lines per ball, which cost one thread's
+// step pass 23.5-25.9 ns per ball-step against 19.5-20.4 with them asked
+// for (12.3 for a stretch of 10 240 of its balls stepped over and over in
+// the caches; technical report, 6.2).
+constexpr std::uint32_t kRecentRows = 16 * kStepBatch;
+
+inline bool is_far_row(std::uint32_t row, std::uint32_t batch) {
+  return row + kRecentRows < batch || row >= batch + kPrefetchBatches * kStepBatch;
+}
+
 // The lists of balls [begin, end), laid out for groups of kLanes balls
 // (broadphase.h): each batch's lists are found into rows of a scratch buffer
 // that stays in the cache and ordered nearest first, the batch is ordered by
@@ -150,7 +179,8 @@ std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t
   std::uint32_t longest = 0;
   for (std::uint32_t batch = begin, last_of_batch; batch < end; batch = last_of_batch) {
     last_of_batch = batch_end(batch, end);
-    BatchReach reach;  // a local: stores to the lists cannot change it
+    BatchReach reach;  // locals: stores to the lists cannot change them
+    FarRows far;
     std::uint8_t group_keys[kStepBatch];
     for (std::uint32_t i = batch; i < last_of_batch; ++i) {
       std::uint32_t* const row = rows.data() + std::size_t(i - batch) * b.stride;
@@ -158,9 +188,14 @@ std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t
       longest = std::max(longest, b.counts[i]);
       const std::uint32_t stored = std::min(b.counts[i], b.stride);
       group_keys[i - batch] = length_contacts_key(order_nearest_first(keys.data(), found.data(), stored, row), stored);
-      for (std::uint32_t k = 0; k < stored; ++k) reach.add(row[k]);
+      for (std::uint32_t k = 0; k < stored; ++k) {
+        reach.add(row[k]);
+        if (b.far_rows && is_far_row(row[k], batch)) [[unlikely]]
+          far.add(row[k]);
+      }
     }
     b.reach[batch / kStepBatch] = reach;
+    if (b.far_rows) b.far_rows[batch / kStepBatch] = far;
     std::uint32_t* order = b.batch_order + batch;
     const std::uint32_t grouped = by_length_and_contacts(group_keys, batch, last_of_batch, kLanes, order);
     std::uint32_t* block = b.neighbours + std::size_t(batch) * b.stride;
@@ -310,19 +345,6 @@ inline void prefetch(const void* base, std::size_t bytes) {
   __builtin_prefetch(reinterpret_cast<const void*>(reinterpret_cast<std::uintptr_t>(base) + bytes), 0, kLocality);
 }
 
-// Beyond the caches (the wide scene from 100 000 balls) a batch's rows arrive
-// late if left to the hardware, which sees them gathered and scattered in the
-// order of the groups, not of the addresses. So each group asks for its share
-// of the rows and lists of the batch kPrefetchBatches ahead: share is the
-// group's place in its batch. At 1 000 000 balls asking one batch ahead took
-// the step pass from 28.7 to 23.7 ns per ball-step, and four ahead (~60 KB of
-// rows and lists, a few microseconds of work) from 16.0-19.2 to 11.3-12.1
-// against one: one batch's ~2 us did not cover the memory's latency under two
-// threads' misses. From cache it changes nothing measurable, and it costs 3 %
-// more instructions, so the world asks for it only for piles larger than the
-// caches (StepArrays::beyond_cache; technical report, 6.2).
-constexpr std::uint32_t kPrefetchBatches = 4;
-
 template <std::uint32_t kCount>
 [[gnu::always_inline]] inline void prefetch_batch_ahead(const StepArrays& s, std::uint32_t batch, std::uint32_t share) {
   const std::size_t ahead = std::size_t(batch) + kPrefetchBatches * kStepBatch;
@@ -338,6 +360,14 @@ template <std::uint32_t kCount>
   const std::size_t lists = ahead * s.stride * sizeof(std::uint32_t);
   for (std::size_t line = share * kCount * 32; line < (share + 1) * kCount * 32; line += kCacheLine)
     prefetch<Reuse::kOnce>(s.neighbours, lists + line);
+  // And the batch's far rows, a few per group.
+  const std::size_t far_batch = ahead / kStepBatch;
+  if (far_batch >= s.batches) return;
+  const FarRows& far = s.far_rows[far_batch];
+  for (std::uint32_t k = share; k < far.count; k += kStepBatch / kCount) {
+    prefetch<Reuse::kAgain>(s.pos, std::size_t(far.rows[k]) * sizeof(Float4));
+    prefetch<Reuse::kAgain>(s.vel_half, std::size_t(far.rows[k]) * sizeof(Float4));
+  }
 }
 
 inline bool in_window(const RowFetch& f, std::uint32_t batch) { return batch >= f.first_batch && batch < f.end_batch; }

@@ -205,7 +205,8 @@ void World::rebuild() {
   for (;;) {
     list_.reserve(n_, list_.stride(), kernels_.list_lanes);
     std::fill(thread_longest_.begin(), thread_longest_.end(), 0u);
-    const ListBuild build = list_.build_view(pos_.data(), n_);
+    ListBuild build = list_.build_view(pos_.data(), n_);
+    if (!beyond_cache()) build.far_rows = nullptr;  // the step asks for nothing ahead
     pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int thread) {
       thread_longest_[thread] = kernels_.build_lists(build, begin, end);
     });
@@ -218,10 +219,6 @@ void World::rebuild() {
   built_at_step_ = steps_;
   far_checked_at_build_ = far_checked_;
 }
-
-// From this many balls the step pass's arrays (about 140 bytes per ball)
-// outgrow the second-level caches of this machine's two cores (1 MB each).
-constexpr std::uint32_t kBeyondCacheBalls = 32768;
 
 StepArrays World::arrays() {
   return StepArrays{pos_.data(),
@@ -237,7 +234,9 @@ StepArrays World::arrays() {
                     player_pos_.data(),
                     player_vel_.data(),
                     static_cast<int>(player_pos_.size()),
-                    n_ >= kBeyondCacheBalls};
+                    beyond_cache(),
+                    list_.far_rows(),
+                    (n_ + kStepBatch - 1) / kStepBatch};
 }
 
 // Neighbouring chunks' threads read each other's edge rows every step, and

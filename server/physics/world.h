@@ -150,6 +150,11 @@ class World {
   void resize(std::uint32_t n);
   void set_ghost();
   StepArrays arrays();
+  // Whether the step pass's arrays (about 140 bytes per ball) outgrow the
+  // second-level caches of this machine's two cores (1 MB each), so that the
+  // step asks for rows ahead (StepArrays::beyond_cache).
+  bool beyond_cache() const { return n_ >= kBeyondCacheBalls; }
+  static constexpr std::uint32_t kBeyondCacheBalls = 32768;
   void derive_velocities() const;
   void add_edge_fetches(StepArrays& s, std::uint32_t begin, std::uint32_t end) const;
 
