@@ -146,20 +146,42 @@ inline std::uint32_t by_length_and_contacts(const std::uint8_t* keys, std::uint3
 // caches (StepArrays::beyond_cache; technical report, 6.2).
 constexpr std::uint32_t kPrefetchBatches = 4;
 
-// The rows of a batch's lists that the step has asked for or read lately
-// when it reaches the batch: those of the kPrefetchBatches batches from it,
-// and those of the 16 batches before it, still in the second-level cache
-// (~290 KB at the ~140 bytes a ball-step moves, of 1 MB). Any other is a far
-// row (broadphase.h, FarRows), asked for with the batch's own rows. In the
-// wide scene's million, 6.9 % of the balls have neighbours across a block's
-// face, 60 000 balls away: 0.09 far lines per ball, which cost one thread's
-// step pass 23.5-25.9 ns per ball-step against 19.5-20.4 with them asked
-// for (12.3 for a stretch of 10 240 of its balls stepped over and over in
-// the caches; technical report, 6.2).
-constexpr std::uint32_t kRecentRows = 16 * kStepBatch;
+// A batch's lists name rows close to it in the sorted order (its own cells
+// and the rows and layers of cells around them), except across a column
+// block's x faces (broadphase.h), where the neighbours lie a whole block of
+// balls away and neither the rows asked for ahead nor those read lately hold
+// them. In the wide scene's million 6.9 % of the balls name such rows,
+// 60 000 balls away, 0.09 cache lines per ball, and they cost one thread's
+// step pass 23.5-25.9 ns per ball-step against 19.5-20.4 with them asked for
+// (12.3 for a stretch of 10 240 of its balls stepped over and over in the
+// caches; technical report, 6.2). So the build notes the rows more than
+// kNearRows from a batch (FarRows), and the step asks for them with the
+// batch's own rows. Nearer rows are left out: behind, the step read them
+// lately and they are still in the second-level cache (~290 KB at the ~140
+// bytes a ball-step moves, of 1 MB); ahead, they are the next layers of
+// cells, within the batch-ahead prefetch's reach in the wide scene, and
+// noting them where a layer holds more balls (~500 in the product's tank)
+// made the list build a quarter slower for nothing.
+constexpr std::uint32_t kNearRows = 16 * kStepBatch;
 
 inline bool is_far_row(std::uint32_t row, std::uint32_t batch) {
-  return row + kRecentRows < batch || row >= batch + kPrefetchBatches * kStepBatch;
+  return row + kNearRows < batch || row >= batch + kStepBatch + kNearRows;
+}
+
+// The far rows of the lists of balls batch..last - 1, stored at rows
+// (b.stride apart); reach says what they name, so a batch whose lists name
+// no far row, as in the product's tank, is not searched.
+inline FarRows far_rows_of(const ListBuild& b, const std::uint32_t* rows, std::uint32_t batch, std::uint32_t last,
+                           BatchReach reach) {
+  FarRows far;
+  if (reach.lowest > reach.highest || (!is_far_row(reach.lowest, batch) && !is_far_row(reach.highest, batch)))
+    return far;
+  for (std::uint32_t i = batch; i < last; ++i) {
+    const std::uint32_t* const row = rows + std::size_t(i - batch) * b.stride;
+    for (std::uint32_t k = 0; k < std::min(b.counts[i], b.stride); ++k)
+      if (is_far_row(row[k], batch)) far.add(row[k]);
+  }
+  return far;
 }
 
 // The lists of balls [begin, end), laid out for groups of kLanes balls
@@ -179,8 +201,7 @@ std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t
   std::uint32_t longest = 0;
   for (std::uint32_t batch = begin, last_of_batch; batch < end; batch = last_of_batch) {
     last_of_batch = batch_end(batch, end);
-    BatchReach reach;  // locals: stores to the lists cannot change them
-    FarRows far;
+    BatchReach reach;  // a local: stores to the lists cannot change it
     std::uint8_t group_keys[kStepBatch];
     for (std::uint32_t i = batch; i < last_of_batch; ++i) {
       std::uint32_t* const row = rows.data() + std::size_t(i - batch) * b.stride;
@@ -188,14 +209,10 @@ std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t
       longest = std::max(longest, b.counts[i]);
       const std::uint32_t stored = std::min(b.counts[i], b.stride);
       group_keys[i - batch] = length_contacts_key(order_nearest_first(keys.data(), found.data(), stored, row), stored);
-      for (std::uint32_t k = 0; k < stored; ++k) {
-        reach.add(row[k]);
-        if (b.far_rows && is_far_row(row[k], batch)) [[unlikely]]
-          far.add(row[k]);
-      }
+      for (std::uint32_t k = 0; k < stored; ++k) reach.add(row[k]);
     }
     b.reach[batch / kStepBatch] = reach;
-    if (b.far_rows) b.far_rows[batch / kStepBatch] = far;
+    if (b.far_rows) b.far_rows[batch / kStepBatch] = far_rows_of(b, rows.data(), batch, last_of_batch, reach);
     std::uint32_t* order = b.batch_order + batch;
     const std::uint32_t grouped = by_length_and_contacts(group_keys, batch, last_of_batch, kLanes, order);
     std::uint32_t* block = b.neighbours + std::size_t(batch) * b.stride;
