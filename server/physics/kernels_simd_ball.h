@@ -180,7 +180,8 @@ inline FarRows far_rows_of(const ListBuild& b, const std::uint32_t* rows, std::u
     return far;
   for (std::uint32_t i = batch; i < last; ++i) {
     const std::uint32_t* const row = rows + std::size_t(i - batch) * b.stride;
-    for (std::uint32_t k = 0; k < std::min(b.counts[i], b.stride); ++k)
+    const std::uint32_t stored = std::min(b.counts[i], b.stride);
+    for (std::uint32_t k = 0; k < stored; ++k)
       if (is_far_row(row[k], batch)) far.add(row[k]);
   }
   return far;

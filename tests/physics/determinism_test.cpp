@@ -94,7 +94,7 @@ TEST_CASE("a pile beyond the caches is bit-identical for 1 and 2 threads, its fa
           "[physics][determinism]") {
   const WideRun one = run_wide(1), two = run_wide(2);
   CHECK(two.hash == one.hash);
-  CHECK(one.far_lines > 0);  // the step did ask for rows across the blocks' faces
+  CHECK(one.far_lines > 0);  // the builds noted rows across the blocks' faces for the step
   CHECK(two.far_lines == one.far_lines);
 }
 
