@@ -72,9 +72,10 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
                  {"sim_seconds", settle.sim_seconds},
                  {"wall_seconds", settle.wall_seconds},
                  {"steps", settle.steps}};
-  j["phase_seconds"] = {{"neighbours", after.neighbours - before.neighbours},
-                        {"step_pass", after.step_pass - before.step_pass},
-                        {"spawn", after.spawn - before.spawn}};
+  j["phase_seconds"] = {
+      {"neighbours", after.neighbours - before.neighbours}, {"sort", after.sort - before.sort},
+      {"list_build", after.list_build - before.list_build}, {"far_checks", after.far_checks - before.far_checks},
+      {"step_pass", after.step_pass - before.step_pass},    {"spawn", after.spawn - before.spawn}};
   j["peak_rss_mib"] = peak_rss_mib();
   j["seed"] = spec.scene.seed;
   return j;

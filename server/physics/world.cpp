@@ -178,6 +178,16 @@ void World::spawn() {
 
 void World::rebuild() {
   PhaseTimer timer(phase_seconds_.neighbours);
+  sort_and_reorder();
+  build_lists();
+  needs_rebuild_ = false;
+  ++rebuilds_;
+  built_at_step_ = steps_;
+  far_checked_at_build_ = far_checked_;
+}
+
+void World::sort_and_reorder() {
+  PhaseTimer timer(phase_seconds_.sort);
   list_.sort(pos_.data(), n_, order_);
   // Gather every per-ball array into cell order, in parallel. The next-step
   // buffers and acc_ are free here (the pass that follows rewrites them), so
@@ -200,7 +210,10 @@ void World::rebuild() {
   kind_.swap(kind_scratch_);
   id_.swap(id_scratch_);
   set_ghost();  // the swapped-in buffers' tails
+}
 
+void World::build_lists() {
+  PhaseTimer timer(phase_seconds_.list_build);
   if (list_.stride() == 0) list_.reserve(n_, 32, kernels_.list_lanes);
   for (;;) {
     list_.reserve(n_, list_.stride(), kernels_.list_lanes);
@@ -214,10 +227,6 @@ void World::rebuild() {
     if (longest <= list_.stride()) break;
     list_.reserve(n_, longest + 8, kernels_.list_lanes);
   }
-  needs_rebuild_ = false;
-  ++rebuilds_;
-  built_at_step_ = steps_;
-  far_checked_at_build_ = far_checked_;
 }
 
 StepArrays World::arrays() {

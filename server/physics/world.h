@@ -40,7 +40,11 @@ struct PhaseSeconds {
   double spawn = 0.0;
   double neighbours = 0.0;  // sort, reorder and list build, and checks that keep the lists
   double step_pass = 0.0;   // forces and integration
-  double far_checks = 0.0;  // the part of neighbours that checks the far balls (World::lists_hold)
+  // Parts of neighbours: the balls sorted by cell and their arrays reordered,
+  // the lists built, and the far balls checked (World::lists_hold).
+  double sort = 0.0;
+  double list_build = 0.0;
+  double far_checks = 0.0;
 };
 
 struct AddResult {
@@ -136,7 +140,10 @@ class World {
 
  private:
   void spawn();
+  // Sorts the balls by cell, reorders every per-ball array, builds the lists.
   void rebuild();
+  void sort_and_reorder();
+  void build_lists();
   // Whether the lists still hold every contact of the next step's positions.
   bool lists_hold();
   float half_skin_d2() const { return 0.25f * params_.skin * params_.skin; }  // (skin / 2)^2

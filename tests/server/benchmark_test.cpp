@@ -70,6 +70,13 @@ TEST_CASE("the benchmark report holds every figure asked for, consistent with th
   const double phases = j["phase_seconds"]["step_pass"].get<double>() + j["phase_seconds"]["neighbours"].get<double>();
   CHECK(j["phase_seconds"]["step_pass"].get<double>() > 0.0);
   CHECK(phases <= seconds * 1.01 + 1e-4);  // the phases are parts of the timed steps
+  // sort, list_build and far_checks are parts of neighbours.
+  const double neighbours = j["phase_seconds"]["neighbours"], sort = j["phase_seconds"]["sort"],
+               lists = j["phase_seconds"]["list_build"], checks = j["phase_seconds"]["far_checks"];
+  CHECK(sort >= 0.0);
+  CHECK(lists >= 0.0);
+  CHECK(checks >= 0.0);
+  CHECK(sort + lists + checks <= neighbours * 1.01 + 1e-6);
   CHECK(j["max_overlap"].get<double>() >= 0.0);
   CHECK(j["max_overlap"].get<double>() < 0.1);
   CHECK(j["pile_top"].get<double>() > 0.0);
