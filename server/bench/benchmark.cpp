@@ -6,6 +6,8 @@
 #include <chrono>
 #include <vector>
 
+#include "server/bench/line_transfer.h"
+
 namespace fishtank {
 
 namespace {
@@ -17,6 +19,9 @@ double peak_rss_mib() {
 }  // namespace
 
 nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleReport& settle) {
+  // The cores' placement before and after: it moves the figures of scenes
+  // whose threads share lines (line_transfer.h).
+  const std::optional<LineTransfer> transfer_before = time_line_transfer();
   const PhaseSeconds before = world.phase_seconds();
   const std::uint64_t rebuilds_before = world.rebuilds(), kept_before = world.lists_kept_far();
   // A shared machine's noise comes in bursts: timing several windows and
@@ -42,6 +47,7 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   const double median_rate =
       sorted.size() % 2 ? sorted[sorted.size() / 2] : 0.5 * (sorted[sorted.size() / 2 - 1] + sorted[sorted.size() / 2]);
   const PhaseSeconds& after = world.phase_seconds();
+  const std::optional<LineTransfer> transfer_after = time_line_transfer();
   const TankBounds& tank = world.params().tank;
 
   nlohmann::json j;
@@ -76,6 +82,12 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
       {"neighbours", after.neighbours - before.neighbours}, {"sort", after.sort - before.sort},
       {"list_build", after.list_build - before.list_build}, {"far_checks", after.far_checks - before.far_checks},
       {"step_pass", after.step_pass - before.step_pass},    {"spawn", after.spawn - before.spawn}};
+  if (transfer_before && transfer_after)
+    j["line_transfer_ns"] = {{"cpus", {transfer_before->cpu_a, transfer_before->cpu_b}},
+                             {"before", transfer_before->ns},
+                             {"after", transfer_after->ns}};
+  else
+    j["line_transfer_ns"] = nullptr;  // fewer than two CPUs
   j["peak_rss_mib"] = peak_rss_mib();
   j["seed"] = spec.scene.seed;
   return j;

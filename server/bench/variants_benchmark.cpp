@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "common/fp_env.h"
+#include "server/bench/line_transfer.h"
 #include "server/bench/scenes.h"
 #include "server/physics/world.h"
 
@@ -224,7 +225,18 @@ int main(int argc, char** argv) {
       ->Unit(benchmark::kMillisecond);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  // The cores' placement, which moves the small scenes' two-thread figures
+  // (line_transfer.h): in the run's context before, on stderr after.
+  auto placement = [] {
+    const std::optional<fishtank::LineTransfer> t = fishtank::time_line_transfer();
+    if (!t) return std::string("not timed: fewer than two CPUs");
+    char text[64];
+    std::snprintf(text, sizeof text, "%.0f ns between CPUs %d and %d", t->ns, t->cpu_a, t->cpu_b);
+    return std::string(text);
+  };
+  benchmark::AddCustomContext("line_transfer_before", placement());
   benchmark::RunSpecifiedBenchmarks();
+  std::fprintf(stderr, "line_transfer_after: %s\n", placement().c_str());
   benchmark::Shutdown();
   return 0;
 }

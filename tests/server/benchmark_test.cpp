@@ -77,6 +77,12 @@ TEST_CASE("the benchmark report holds every figure asked for, consistent with th
   CHECK(lists >= 0.0);
   CHECK(checks >= 0.0);
   CHECK(sort + lists + checks <= neighbours * 1.01 + 1e-6);
+  // The cores' placement, timed before and after (line_transfer.h), where there are two.
+  REQUIRE(j.contains("line_transfer_ns"));
+  if (!j["line_transfer_ns"].is_null()) {
+    CHECK(j["line_transfer_ns"]["before"].get<double>() > 0.0);
+    CHECK(j["line_transfer_ns"]["after"].get<double>() > 0.0);
+  }
   if (j["rebuilds"].get<int>() > 0) {  // each rebuild sorts and builds
     CHECK(sort > 0.0);
     CHECK(lists > 0.0);
