@@ -13,7 +13,9 @@
 // A shared virtual machine's speed drifts by tens of percent over minutes.
 // Run with random interleaving and repetitions so every case samples the same
 // drift, and compare medians; --benchmark_filter=step_tank or step_wide picks
-// a family (the wide worlds take a few minutes to build).
+// a family (the wide worlds take a few minutes to build). The run also says
+// where the host placed the cores (line_transfer.h), which moves the small
+// wide scene's figure, before (in its context) and after (on stderr).
 
 #include <benchmark/benchmark.h>
 
