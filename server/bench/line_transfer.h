@@ -1,7 +1,7 @@
 #pragma once
 // Where the host placed this machine's cores, as a time: a cache line's trip
 // from one core to another. On a shared virtual machine two virtual cores may
-// sit on one core complex (~60-90 ns here) or on two (~220-350 ns), and the
+// sit close (~40-90 ns here) or apart (~220-350 ns, at times ~1 us), and the
 // placement changes from hour to hour; a scene whose threads share lines, as
 // a small one does along its chunks' edges, runs a third faster in the first
 // case (technical report, 6.2). The benchmarks print it so that a run says
