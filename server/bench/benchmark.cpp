@@ -24,6 +24,7 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   const std::optional<LineTransfer> transfer_before = time_line_transfer();
   const PhaseSeconds before = world.phase_seconds();
   const std::uint64_t rebuilds_before = world.rebuilds(), kept_before = world.lists_kept_far();
+  world.reset_thread_shares();
   // A shared machine's noise comes in bursts: timing several windows and
   // reporting the median keeps one burst from deciding the figure.
   const std::uint32_t windows = static_cast<std::uint32_t>(std::clamp<std::uint64_t>(spec.windows, 1, spec.steps));
@@ -55,7 +56,7 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   j["variant"] = world.kernels().variant;
   j["simd"] = world.kernels().simd;
   j["threads"] = world.threads();
-  j["thread_shares"] = world.thread_shares();  // the split the last timed step measured its way to
+  j["thread_shares"] = world.thread_shares();  // of the items the timed steps' passes computed
   j["balls"] = world.ball_count();
   j["steps"] = spec.steps;
   j["seconds"] = seconds;

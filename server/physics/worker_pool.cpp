@@ -5,45 +5,48 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <numeric>
 
 #include "common/fp_env.h"
 
 namespace fishtank {
 
 namespace {
-// How long an idle worker polls before it sleeps. Waking a sleeping thread
-// costs tens to hundreds of microseconds on a virtual machine, paid on every
-// pass if workers sleep between them: measured on the paced server with 6000
-// balls, 45 % load with ~10 us of polling against 23 % with 1 ms. One
-// millisecond bridges every gap inside a batch of steps, while the workers of
-// a paced server still sleep through the longer gaps between batches.
-constexpr auto kSpinTime = std::chrono::microseconds(1000);
-// The main thread's wait for the last chunk: this many polls, then yields.
-constexpr int kSpinIterations = 2000;
+using Clock = std::chrono::steady_clock;
+// How long an idle worker polls before it sleeps: long enough to bridge the
+// gaps between the passes of a step, short enough that a paced server's
+// workers sleep between its batches of steps.
+constexpr auto kWorkerSpin = std::chrono::microseconds(1000);
+// How long the caller polls for the last chunks before it sleeps: about one
+// chunk's time, so that a thread descheduled inside a chunk gets the core back.
+constexpr auto kCallerSpin = std::chrono::microseconds(50);
 // Fewer items than this per thread cost more to hand out than to compute.
 constexpr std::uint32_t kMinItemsPerThread = 1024;
-// A timed run moves the split only when its slowest chunk took this much
-// longer than the chunks' mean: below it, timing noise would move blocks
-// between the cores back and forth.
-constexpr double kImbalanceToAct = 0.03;
-// ... and then this fraction of the way towards the split that would have
-// balanced it, so that one slow run (a thread preempted) moves it little.
-constexpr double kBalanceRate = 0.25;
-// No thread's speed is taken as less than this fraction of the mean, so that
-// each keeps a chunk to be measured by.
-constexpr double kMinRelativeSpeed = 0.25;
+// generation_ keeps the active thread count in its low bits.
+constexpr int kActiveBits = 16;
+constexpr std::uint64_t kActiveMask = (std::uint64_t{1} << kActiveBits) - 1;
+
+// Claims::word: the generation's low 32 bits, then front and back, 16 bits each.
+std::uint64_t claims_word(std::uint32_t tag, std::uint32_t front, std::uint32_t back) {
+  return std::uint64_t{tag} << 32 | std::uint64_t{front} << 16 | back;
+}
+
+void pause_until(const std::atomic<std::uint64_t>& value, std::uint64_t seen, Clock::time_point give_up) {
+  for (int spins = 1; value.load(std::memory_order_acquire) == seen; ++spins) {
+    _mm_pause();
+    if (spins % 64 == 0 && Clock::now() > give_up) return;
+  }
+}
 }  // namespace
 
 int WorkerPool::hardware_threads() { return std::max(1u, boost::thread::hardware_concurrency()); }
 
 WorkerPool::WorkerPool(int threads, std::uint32_t granule)
-    : thread_count_(std::max(1, threads)),
+    : thread_count_(std::clamp(threads, 1, 1 << 10)),
       granule_(std::max(1u, granule)),
       active_limit_(thread_count_),
-      chunk_start_(thread_count_ + 1),
-      chunk_time_(thread_count_),
-      speed_(thread_count_, 1.0) {
+      chunk_start_(max_chunks() + 1),
+      claims_(thread_count_),
+      items_done_(thread_count_) {
   for (int t = 1; t < thread_count_; ++t) workers_.emplace_back([this, t] { worker_loop(t); });
 }
 
@@ -51,7 +54,7 @@ WorkerPool::~WorkerPool() {
   {
     boost::lock_guard<boost::mutex> lock(mutex_);
     stopping_ = true;
-    generation_.fetch_add(1);
+    generation_.fetch_add(std::uint64_t{1} << kActiveBits);
   }
   wake_.notify_all();
   for (boost::thread& w : workers_) w.join();
@@ -59,97 +62,103 @@ WorkerPool::~WorkerPool() {
 
 void WorkerPool::set_active_limit(int limit) { active_limit_ = std::clamp(limit, 1, thread_count_); }
 
-std::vector<double> WorkerPool::shares(int active) const {
-  active = std::clamp(active, 1, thread_count_);
-  const double total = std::accumulate(speed_.begin(), speed_.begin() + active, 0.0);
-  std::vector<double> share(active);
-  for (int t = 0; t < active; ++t) share[t] = speed_[t] / total;
+std::vector<double> WorkerPool::shares() const {
+  double total = 0.0;
+  for (const ItemCount& done : items_done_) total += done.items;
+  std::vector<double> share(thread_count_, 0.0);
+  for (int t = 0; t < thread_count_ && total > 0.0; ++t) share[t] = items_done_[t].items / total;
   return share;
 }
 
-void WorkerPool::split(std::uint32_t count, std::uint32_t granule) {
-  const double total = std::accumulate(speed_.begin(), speed_.begin() + active_, 0.0);
-  double before = 0.0;
-  chunk_start_[0] = 0;
-  for (int t = 1; t < active_; ++t) {
-    before += speed_[t - 1];
-    // The nearest multiple of the granule: rounding down would hand the last thread up to a granule more.
-    const double start = std::floor(count * (before / total) / granule + 0.5) * granule;
-    chunk_start_[t] = std::max(chunk_start_[t - 1], static_cast<std::uint32_t>(std::min<double>(count, start)));
-  }
-  chunk_start_[active_] = count;
+void WorkerPool::reset_shares() {
+  for (ItemCount& done : items_done_) done.items = 0;
 }
 
-void WorkerPool::run_chunk(int thread) {
-  if (thread >= active_) return;
-  const std::uint32_t begin = chunk_start_[thread], end = chunk_start_[thread + 1];
-  if (begin >= end) return;
-  if (!timed_) {
-    (*phase_)(begin, end, thread);
-    return;
-  }
-  const auto start = std::chrono::steady_clock::now();
-  (*phase_)(begin, end, thread);
-  chunk_time_[thread].seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-void WorkerPool::balance() {
-  double sum = 0.0, slowest = 0.0;
-  for (int t = 0; t < active_; ++t) {
-    if (chunk_start_[t] == chunk_start_[t + 1] || !(chunk_time_[t].seconds > 0.0)) return;  // nothing to go by
-    sum += chunk_time_[t].seconds;
-    slowest = std::max(slowest, chunk_time_[t].seconds);
-  }
-  if (slowest <= (1.0 + kImbalanceToAct) * sum / active_) return;
-  // Items per second measured, scaled to the current speeds' total.
-  double measured_total = 0.0;
-  const double speed_total = std::accumulate(speed_.begin(), speed_.begin() + active_, 0.0);
-  for (int t = 0; t < active_; ++t) measured_total += (chunk_start_[t + 1] - chunk_start_[t]) / chunk_time_[t].seconds;
-  for (int t = 0; t < active_; ++t) {
-    const double measured = (chunk_start_[t + 1] - chunk_start_[t]) / chunk_time_[t].seconds;
-    const double target = measured * speed_total / measured_total;
-    speed_[t] = std::max(speed_[t] + kBalanceRate * (target - speed_[t]), kMinRelativeSpeed * speed_total / active_);
+int WorkerPool::claim(int owner, bool from_front, std::uint32_t tag) {
+  std::atomic<std::uint64_t>& word = claims_[owner].word;
+  std::uint64_t w = word.load(std::memory_order_acquire);
+  for (;;) {
+    const std::uint32_t front = (w >> 16) & 0xffff, back = w & 0xffff;
+    if (std::uint32_t(w >> 32) != tag || front >= back) return -1;
+    const std::uint64_t next = from_front ? claims_word(tag, front + 1, back) : claims_word(tag, front, back - 1);
+    if (word.compare_exchange_weak(w, next, std::memory_order_acq_rel, std::memory_order_acquire))
+      return static_cast<int>(from_front ? front : back - 1);
   }
 }
 
-void WorkerPool::run(std::uint32_t count, const Phase& phase) {
-  run(count, phase, {granule_, kMinItemsPerThread}, false);
+void WorkerPool::work(int thread, std::uint64_t generation) {
+  const auto tag = static_cast<std::uint32_t>(generation >> kActiveBits);
+  const auto active = static_cast<int>(generation & kActiveMask);
+  // Read once a chunk is held: until every chunk is done, nothing changes them.
+  const auto run_chunk = [&](int c) {
+    const std::uint32_t begin = chunk_start_[c], end = chunk_start_[c + 1], chunks = chunk_count_;
+    if (begin < end) (*phase_)(begin, end, c);
+    items_done_[thread].items += end - begin;
+    if (chunks_done_.fetch_add(1, std::memory_order_acq_rel) + 1 == chunks) {
+      boost::lock_guard<boost::mutex> lock(done_mutex_);
+      done_.notify_one();
+    }
+  };
+  for (int c; (c = claim(thread, true, tag)) >= 0;) run_chunk(c);
+  for (int k = 1; k < active; ++k)
+    for (int c; (c = claim((thread + k) % active, false, tag)) >= 0;) run_chunk(c);
 }
 
-void WorkerPool::run_and_balance(std::uint32_t count, const Phase& phase) {
-  run(count, phase, {granule_, kMinItemsPerThread}, true);
+void WorkerPool::wait_for_chunks() {
+  const std::uint32_t total = chunk_count_;
+  const auto all_done = [&] { return chunks_done_.load(std::memory_order_acquire) == total; };
+  const Clock::time_point give_up = Clock::now() + kCallerSpin;
+  for (int spins = 1; !all_done(); ++spins) {
+    _mm_pause();
+    if (spins % 64 == 0 && Clock::now() > give_up) {
+      boost::unique_lock<boost::mutex> lock(done_mutex_);
+      done_.wait(lock, all_done);
+      return;
+    }
+  }
 }
+
+void WorkerPool::run(std::uint32_t count, const Phase& phase) { run(count, phase, granule_, kMinItemsPerThread); }
 
 void WorkerPool::run_costly(std::uint32_t count, std::uint32_t min_per_thread, const Phase& phase) {
-  run(count, phase, {1, std::max(1u, min_per_thread)}, false);
+  run(count, phase, 1, std::max(1u, min_per_thread));
 }
 
-void WorkerPool::run(std::uint32_t count, const Phase& phase, Grain grain, bool timed) {
-  const int useful = static_cast<int>(std::min<std::uint32_t>(count / grain.min_per_thread, active_limit_));
-  if (useful <= 1) {
+void WorkerPool::run(std::uint32_t count, const Phase& phase, std::uint32_t granule, std::uint32_t min_per_thread) {
+  const int active = static_cast<int>(std::min<std::uint32_t>(count / min_per_thread, active_limit_));
+  if (active <= 1) {
     if (count > 0) phase(0, count, 0);
+    items_done_[0].items += count;
     return;
   }
+  const std::uint32_t granules = (count + granule - 1) / granule;
+  chunk_count_ = std::min<std::uint32_t>(active * kChunksPerThread, granules);
+  chunk_start_[0] = 0;
+  for (std::uint32_t c = 1; c < chunk_count_; ++c) {
+    // The nearest multiple of the granule: rounding down would give the last chunk up to a granule more.
+    const double start = std::floor(double(count) * c / chunk_count_ / granule + 0.5) * granule;
+    chunk_start_[c] = std::max(chunk_start_[c - 1], static_cast<std::uint32_t>(std::min<double>(count, start)));
+  }
+  chunk_start_[chunk_count_] = count;
+
+  const std::uint64_t generation =
+      ((generation_.load(std::memory_order_relaxed) >> kActiveBits) + 1) << kActiveBits | std::uint64_t(active);
+  const auto tag = static_cast<std::uint32_t>(generation >> kActiveBits);
+  for (int t = 0; t < thread_count_; ++t) {
+    const std::uint32_t front = t < active ? chunk_count_ * t / active : 0;
+    const std::uint32_t back = t < active ? chunk_count_ * (t + 1) / active : 0;
+    claims_[t].word.store(claims_word(tag, front, back), std::memory_order_relaxed);
+  }
   phase_ = &phase;
-  active_ = useful;
-  timed_ = timed;
-  split(count, grain.granule);
-  pending_.store(thread_count_ - 1, std::memory_order_relaxed);
+  chunks_done_.store(0, std::memory_order_relaxed);
   {
     // Taking the lock orders the publish against a worker that is about to sleep.
     boost::lock_guard<boost::mutex> lock(mutex_);
-    generation_.fetch_add(1, std::memory_order_release);
+    generation_.store(generation, std::memory_order_release);
   }
   wake_.notify_all();
-  run_chunk(0);
-  // Yield once the other threads are late, so an oversubscribed machine still progresses.
-  for (int spins = 0; pending_.load(std::memory_order_acquire) != 0; ++spins) {
-    if (spins < kSpinIterations)
-      _mm_pause();
-    else
-      boost::this_thread::yield();
-  }
-  if (timed) balance();
+  work(0, generation);
+  wait_for_chunks();
 }
 
 void WorkerPool::wake() {
@@ -165,11 +174,7 @@ void WorkerPool::worker_loop(int thread) {
   enable_flush_denormals_to_zero();
   std::uint64_t seen = 0;
   for (;;) {
-    const auto give_up = std::chrono::steady_clock::now() + kSpinTime;
-    for (int spins = 1; generation_.load(std::memory_order_acquire) == seen; ++spins) {
-      _mm_pause();
-      if (spins % 64 == 0 && std::chrono::steady_clock::now() > give_up) break;
-    }
+    pause_until(generation_, seen, Clock::now() + kWorkerSpin);
     if (generation_.load(std::memory_order_acquire) == seen) {
       boost::unique_lock<boost::mutex> lock(mutex_);
       const std::uint64_t wake_calls = wake_calls_.load(std::memory_order_relaxed);
@@ -181,8 +186,9 @@ void WorkerPool::worker_loop(int thread) {
     }
     seen = generation_.load(std::memory_order_acquire);
     if (stopping_.load()) return;
-    run_chunk(thread);
-    pending_.fetch_sub(1, std::memory_order_release);
+    if (thread >= static_cast<int>(seen & kActiveMask)) continue;
+    if (worker_hook_) worker_hook_(thread);
+    work(thread, seen);
   }
 }
 

@@ -2,30 +2,23 @@
 // Boost.Thread worker pool that runs one phase of a step on every thread.
 //
 //   caller (thread 0) ── run(phase) ──► generation++ ──► workers 1..T-1 wake
-//        │ does chunk 0                                   each does chunk t
-//        └──────── waits until `pending` reaches 0 ◄─────────┘
+//        │ claims chunks                                 each claims chunks
+//        └──────── waits until every chunk is done ◄─────────┘
 //
-// Work is split into T contiguous chunks, so each thread streams through its
-// own part of the arrays. Chunks start at multiples of a granule, so every
-// pass over the same count puts each granule-sized block of items on one
-// thread, whatever the number of threads (the SIMD kernels keep per-block
-// data from one pass to the next).
+// A phase's items are cut into a few chunks per thread, and each thread owns
+// a contiguous run of them, so on a quiet machine every thread streams
+// through the same part of the arrays pass after pass. A thread that has
+// finished its own chunks takes unstarted ones from the back of the others'
+// runs. So a thread the OS has not scheduled (a busy machine) or that runs
+// slowly (a core shared on the host) never holds up a pass beyond the chunk it
+// is inside: the caller finishes the rest. Every claim carries the phase's
+// generation, so a worker that wakes late cannot take a later phase's chunk
+// for its own.
 //
-// The split follows the threads' speeds. Cores of a virtual machine are not
-// equal: on this project's 2-core machine one of them ran 30 % slower than
-// the other for minutes at a time (a neighbour on the host), and with equal
-// chunks the fast thread then waits for the slow one at the end of every
-// pass. run_and_balance() times each chunk and moves every later split
-// towards chunks that take equal time (smoothed, and only for a clear
-// imbalance, so that noise does not shuffle blocks between cores: a block
-// that changes thread costs its cache lines a trip between the cores). A
-// phase lasts tens of microseconds in benchmark mode, so workers spin briefly
-// before sleeping on a condition variable: a wake-up from spinning costs well
-// under a microsecond, one from sleep several. With one thread, run() is a
-// plain call with no synchronisation at all, and so is a phase too small to
-// be worth splitting (under ~1000 items per thread). Results never depend on
-// the split, so neither on timing: each item is computed by exactly one
-// thread, the same way.
+// Chunks start at multiples of a granule, and results never depend on which
+// thread computes a chunk: each item is computed by exactly one thread, the
+// same way. With one thread, or too few items to be worth splitting, run() is
+// a plain call with no synchronisation at all.
 
 #include <atomic>
 #include <boost/thread/condition_variable.hpp>
@@ -39,8 +32,9 @@ namespace fishtank {
 
 class WorkerPool {
  public:
-  // Chunk [begin, end) of `count` items, on thread `thread`.
-  using Phase = std::function<void(std::uint32_t begin, std::uint32_t end, int thread)>;
+  // Items [begin, end) of the phase. `chunk` numbers the chunks in item order,
+  // below max_chunks(), so a phase can keep one result per chunk.
+  using Phase = std::function<void(std::uint32_t begin, std::uint32_t end, int chunk)>;
 
   WorkerPool(int threads, std::uint32_t granule);
   ~WorkerPool();
@@ -48,62 +42,73 @@ class WorkerPool {
   WorkerPool& operator=(const WorkerPool&) = delete;
 
   int threads() const { return thread_count_; }
+  int max_chunks() const { return thread_count_ * kChunksPerThread; }
   // Passes use at most this many threads (1..threads()); the others stay idle.
   void set_active_limit(int limit);
   int active_limit() const { return active_limit_; }
-  // Runs phase on `count` items, one chunk per thread, split by the speeds
-  // measured so far (equal chunks until a run has measured them).
+  // Runs phase on `count` items, in chunks claimed by the active threads.
   void run(std::uint32_t count, const Phase& phase);
-  // The same, timing each thread's chunk to adapt later splits: for the pass
-  // that takes most of the time, whose chunks' speeds the split should match.
-  void run_and_balance(std::uint32_t count, const Phase& phase);
-  // For items that each cost as much as hundreds of balls' steps (a far
+  // For items that each cost as much as hundreds of balls' steps (a moved
   // ball's check): splits from `min_per_thread` items per thread, in chunks
-  // of any length, by the same speeds.
+  // of any length.
   void run_costly(std::uint32_t count, std::uint32_t min_per_thread, const Phase& phase);
-  // Each thread's fraction of the items in a run on `active` threads.
-  std::vector<double> shares(int active) const;
+  // Each thread's fraction of the items computed since the last reset_shares()
+  // (or construction), one entry per thread.
+  std::vector<double> shares() const;
+  void reset_shares();
   // Wakes sleeping workers now so that they are polling, not asleep, when a
   // run() comes within the next millisecond: a paced caller pays the wake-up
   // while it waits for its next batch instead of inside the batch.
   void wake();
+  // For tests: called on a worker thread when it picks up a phase, before it
+  // claims a chunk (to stall it on purpose). Set before the first run.
+  void set_worker_hook(std::function<void(int thread)> hook) { worker_hook_ = std::move(hook); }
 
   // The run-time default: one thread per available core.
   static int hardware_threads();
 
  private:
-  // One chunk's duration, on its own cache line: each thread writes its own.
-  struct alignas(64) ChunkTime {
-    double seconds = 0.0;
+  // Few enough that claiming costs nothing next to a chunk, enough that the
+  // caller's share of a stalled thread's work comes in small pieces.
+  static constexpr int kChunksPerThread = 4;
+
+  // A thread's unclaimed chunks [front, back) in the phase of generation
+  // `tag`, packed in one word so that a claim is a single compare-and-swap.
+  struct alignas(64) Claims {
+    std::atomic<std::uint64_t> word{0};
+  };
+  struct alignas(64) ItemCount {
+    std::uint64_t items = 0;
   };
 
   void worker_loop(int thread);
-  void run_chunk(int thread);
-  // What a run's items cost: chunks start at multiples of `granule`, and a
-  // run is split only with at least `min_per_thread` items per thread.
-  struct Grain {
-    std::uint32_t granule, min_per_thread;
-  };
-  void run(std::uint32_t count, const Phase& phase, Grain grain, bool timed);
-  void split(std::uint32_t count, std::uint32_t granule);
-  void balance();
+  // Runs chunks until none is left: the thread's own from the front, then the
+  // others' from the back, of the phase of `generation`.
+  void work(int thread, std::uint64_t generation);
+  int claim(int owner, bool from_front, std::uint32_t tag);
+  void run(std::uint32_t count, const Phase& phase, std::uint32_t granule, std::uint32_t min_per_thread);
+  void wait_for_chunks();
 
   int thread_count_;
   std::uint32_t granule_;
   int active_limit_;
   std::vector<boost::thread> workers_;
+  std::function<void(int)> worker_hook_;
+  // The current phase, written before its generation is published.
   const Phase* phase_ = nullptr;
-  int active_ = 1;  // threads given a chunk in the current phase
-  bool timed_ = false;
-  std::vector<std::uint32_t> chunk_start_;  // the current phase's chunks: [start[t], start[t + 1])
-  std::vector<ChunkTime> chunk_time_;
-  std::vector<double> speed_;  // per thread, relative: the split gives each a share in proportion
+  std::uint32_t chunk_count_ = 0;
+  std::vector<std::uint32_t> chunk_start_;  // chunk c is [start[c], start[c + 1])
+  std::vector<Claims> claims_;
+  std::vector<ItemCount> items_done_;  // per thread, since reset_shares()
+  // Phases published so far (high bits) and the threads they use (low byte).
   std::atomic<std::uint64_t> generation_{0};
   std::atomic<std::uint64_t> wake_calls_{0};
-  std::atomic<int> pending_{0};
+  std::atomic<std::uint32_t> chunks_done_{0};
   std::atomic<bool> stopping_{false};
   boost::mutex mutex_;
   boost::condition_variable wake_;
+  boost::mutex done_mutex_;
+  boost::condition_variable done_;
 };
 
 }  // namespace fishtank

@@ -46,9 +46,9 @@ World::World(const PhysicsParams& params, const Kernels& kernels, int threads, s
   list_.configure(params.tank, params.skin);
   capacity_ = static_cast<std::uint32_t>(kPackingLimit * params.tank.volume() / mean_ball_volume());
   max_balls_ = capacity_;
-  thread_moved_.resize(pool_.threads());
-  thread_missing_.resize(pool_.threads());
-  thread_longest_.resize(pool_.threads());
+  chunk_moved_.resize(pool_.max_chunks());
+  chunk_missing_.resize(pool_.max_chunks());
+  chunk_longest_.resize(pool_.max_chunks());
   resize(0);
 }
 
@@ -217,13 +217,13 @@ void World::build_lists() {
   if (list_.stride() == 0) list_.reserve(n_, 32, kernels_.list_lanes);
   for (;;) {
     list_.reserve(n_, list_.stride(), kernels_.list_lanes);
-    std::fill(thread_longest_.begin(), thread_longest_.end(), 0u);
+    std::fill(chunk_longest_.begin(), chunk_longest_.end(), 0u);
     ListBuild build = list_.build_view(pos_.data(), n_);
     if (!beyond_cache()) build.far_rows = nullptr;  // the step asks for nothing ahead
-    pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int thread) {
-      thread_longest_[thread] = kernels_.build_lists(build, begin, end);
+    pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int chunk) {
+      chunk_longest_[chunk] = kernels_.build_lists(build, begin, end);
     });
-    std::uint32_t longest = *std::max_element(thread_longest_.begin(), thread_longest_.end());
+    std::uint32_t longest = *std::max_element(chunk_longest_.begin(), chunk_longest_.end());
     if (longest <= list_.stride()) break;
     list_.reserve(n_, longest + 8, kernels_.list_lanes);
   }
@@ -355,7 +355,7 @@ bool World::lists_hold() {
   if (!list_.can_check(moved)) return false;
   // Each chunk listed its far balls from its begin: gather them to the front.
   std::uint32_t far = 0;
-  for (const ChunkMoved& chunk : thread_moved_) {
+  for (const ChunkMoved& chunk : chunk_moved_) {
     std::copy_n(far_balls_.begin() + chunk.begin, chunk.moved.far, far_balls_.begin() + far);
     far += chunk.moved.far;
   }
@@ -369,13 +369,13 @@ bool World::lists_hold() {
   if (double(far) * steps_since_build >= cycle_cost || far > n_ / kFarBallsPerCheck + 16) return false;
   far_checked_ += far;
   PhaseTimer timer(phase_seconds_.neighbours), check_timer(phase_seconds_.far_checks);
-  std::fill(thread_missing_.begin(), thread_missing_.end(), 0);
+  std::fill(chunk_missing_.begin(), chunk_missing_.end(), 0);
   // A check costs a few dozen balls' steps (0.2-0.5 us): a few are worth a thread.
-  pool_.run_costly(far, kFarChecksPerThread, [&](std::uint32_t begin, std::uint32_t end, int thread) {
-    for (std::uint32_t k = begin; k < end && !thread_missing_[thread]; ++k)
-      thread_missing_[thread] = list_.misses_contact(far_balls_[k], pos_.data(), pos_at_build_.data(), moved);
+  pool_.run_costly(far, kFarChecksPerThread, [&](std::uint32_t begin, std::uint32_t end, int chunk) {
+    for (std::uint32_t k = begin; k < end && !chunk_missing_[chunk]; ++k)
+      chunk_missing_[chunk] = list_.misses_contact(far_balls_[k], pos_.data(), pos_at_build_.data(), moved);
   });
-  if (std::find(thread_missing_.begin(), thread_missing_.end(), 1) != thread_missing_.end()) return false;
+  if (std::find(chunk_missing_.begin(), chunk_missing_.end(), 1) != chunk_missing_.end()) return false;
   ++lists_kept_far_;
   return true;
 }
@@ -391,18 +391,17 @@ void World::step() {
   if (needs_rebuild_ || !lists_hold()) rebuild();
 
   PhaseTimer timer(phase_seconds_.step_pass);
-  std::fill(thread_moved_.begin(), thread_moved_.end(), ChunkMoved{});
+  std::fill(chunk_moved_.begin(), chunk_moved_.end(), ChunkMoved{});
   StepArrays s = arrays();
   s.far_d2 = half_skin_d2() * kFarMargin;  // every ball lists_hold() will count as far, and a hair more
   s.far_balls = far_balls_.data();
-  // The pass that takes most of the time: the split of every pass follows its threads' speeds.
-  pool_.run_and_balance(n_, [&](std::uint32_t begin, std::uint32_t end, int thread) {
-    StepArrays chunk = s;
-    add_edge_fetches(chunk, begin, end);
-    thread_moved_[thread] = {begin, kernels_.step(chunk, model_, begin, end)};
+  pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int chunk) {
+    StepArrays part = s;
+    add_edge_fetches(part, begin, end);
+    chunk_moved_[chunk] = {begin, kernels_.step(part, model_, begin, end)};
   });
   next_max_d2_ = 0.0f;
-  for (const ChunkMoved& chunk : thread_moved_) next_max_d2_ = std::max(next_max_d2_, chunk.moved.max_d2);
+  for (const ChunkMoved& chunk : chunk_moved_) next_max_d2_ = std::max(next_max_d2_, chunk.moved.max_d2);
   far_listed_ = true;
   vel_stale_ = true;
   time_ += model_.dt;

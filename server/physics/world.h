@@ -108,9 +108,11 @@ class World {
   // Steps use at most this many of the threads (results do not depend on it).
   void set_thread_limit(int limit) { pool_.set_active_limit(limit); }
   int thread_limit() const { return pool_.active_limit(); }
-  // Each thread's fraction of the balls, as the worker pool splits them now
-  // by the threads' measured speeds (WorkerPool::run_and_balance).
-  std::vector<double> thread_shares() const { return pool_.shares(pool_.active_limit()); }
+  // Each thread's fraction of the items of every pass since reset_thread_shares().
+  std::vector<double> thread_shares() const { return pool_.shares(); }
+  void reset_thread_shares() { pool_.reset_shares(); }
+  // For tests: runs on a worker thread as it picks up each pass (WorkerPool::set_worker_hook).
+  void set_worker_hook(std::function<void(int thread)> hook) { pool_.set_worker_hook(std::move(hook)); }
   const PhaseSeconds& phase_seconds() const { return phase_seconds_; }
   double mean_neighbours() const;
 
@@ -214,16 +216,16 @@ class World {
   // this machine's noise: +1.4, -1.5 and +1.5 % of a settled tank's step).
   static constexpr std::uint32_t kFarChecksPerThread = 4;
   static constexpr float kFarMargin = 1.0f - 1e-5f;  // a ball right at skin / 2 counts as far
-  // What each thread's chunk of the last step pass reported.
+  // What each chunk of the last step pass reported.
   struct ChunkMoved {
     std::uint32_t begin = 0;
     Moved moved;
   };
-  std::vector<ChunkMoved> thread_moved_;
-  std::vector<char> thread_missing_;      // per thread: a far ball misses a contact
+  std::vector<ChunkMoved> chunk_moved_;
+  std::vector<char> chunk_missing_;       // per chunk: a far ball misses a contact
   std::vector<std::uint32_t> far_balls_;  // per chunk, from its begin: its far balls
   bool far_listed_ = false;               // whether the last pass listed them
-  std::vector<std::uint32_t> thread_longest_;
+  std::vector<std::uint32_t> chunk_longest_;  // per chunk: the longest list it built
   std::vector<std::uint32_t> order_;
   std::vector<NewBall> placed_;
   double time_ = 0.0;

@@ -4,10 +4,13 @@
 // velocity, as Box2D does).
 
 #include <algorithm>
+#include <atomic>
 #include <catch2/catch.hpp>
+#include <chrono>
 #include <cstring>
 #include <numeric>
 #include <random>
+#include <thread>
 #include <vector>
 
 #include "tests/physics/scenarios.h"
@@ -16,12 +19,16 @@ using namespace fishtank;
 
 namespace {
 
-std::uint64_t run(const Kernels& kernels, int threads) {
+// `hook` runs on each worker thread as it picks up a pass, and `at_step`
+// before each step (to stall a worker on purpose).
+std::uint64_t run(const Kernels& kernels, int threads, std::function<void(int)> hook = {},
+                  std::function<void(int)> at_step = {}) {
   // 5000 balls, so that even 4 threads each get a chunk worth splitting off.
   PhysicsParams params;
   params.tank.min = {-40.0f, 0.0f, -40.0f};
   params.tank.max = {40.0f, 40.0f, 40.0f};
   World world(params, kernels, threads, 99);
+  if (hook) world.set_worker_hook(std::move(hook));
   for (int b = 0; b < 5000; ++b) {
     Vec3 p{-39.0f + 3.05f * (b % 26), 1.6f + 3.05f * (b / 676), -39.0f + 3.05f * ((b / 26) % 26)};
     world.place_ball(b % kKindCount, p, Vec3{0.1f * (b % 7) - 0.3f, 0.0f, 0.1f * (b % 5) - 0.2f});
@@ -30,6 +37,7 @@ std::uint64_t run(const Kernels& kernels, int threads) {
   world.set_player_velocity(player, {3.0f, -4.0f, 1.0f});
   for (int s = 0; s < 1500; ++s) {
     if (s == 750) world.set_player_velocity(player, {-6.0f, 2.0f, 0.0f});
+    if (at_step) at_step(s);
     world.step();
   }
   REQUIRE(world.threads() == threads);
@@ -43,6 +51,31 @@ TEST_CASE("state is bit-identical for 1, 2 and 4 threads", "[physics][determinis
   const std::uint64_t one = run(kSseKernels, 1);
   CHECK(run(kSseKernels, 2) == one);
   CHECK(run(kSseKernels, 4) == one);
+}
+
+TEST_CASE("a stalled worker holds up no step and changes nothing", "[physics][determinism]") {
+  using Clock = std::chrono::steady_clock;
+  const std::uint64_t one = run(kSseKernels, 1);
+  // Worker 1 is held back a little on every fifth pass it picks up, so the
+  // caller takes its chunks in ever-changing order, and for steps 300-399 it
+  // is held outright (up to 5 s a pass, were the step to wait for it).
+  std::atomic<int> passes{0};
+  std::atomic<bool> held{false};
+  Clock::time_point held_from, held_to;
+  const auto hook = [&](int thread) {
+    if (thread != 1) return;
+    if (passes.fetch_add(1) % 5 == 0) std::this_thread::sleep_for(std::chrono::microseconds(300));
+    const Clock::time_point give_up = Clock::now() + std::chrono::seconds(5);
+    while (held.load() && Clock::now() < give_up) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  };
+  const auto at_step = [&](int s) {
+    if (s == 300) held = true, held_from = Clock::now();
+    if (s == 400) held = false, held_to = Clock::now();
+  };
+  CHECK(run(kSseKernels, 2, hook, at_step) == one);
+  CHECK(passes > 0);
+  // A hundred steps while the worker was held: had any waited for it, 5 s or more.
+  CHECK(std::chrono::duration<double>(held_to - held_from).count() < 4.0);
 }
 
 TEST_CASE("the AVX2 level's state is bit-identical for 1, 2 and 3 threads", "[physics][determinism]") {
