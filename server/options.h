@@ -13,6 +13,8 @@ namespace fishtank {
 struct ServerOptions {
   bool bench = false;
   BenchSpec bench_spec;
+  // Steps choose between every thread and one by measurement unless fixed.
+  bool fixed_threads = false;
   int threads = 1;
   std::uint32_t start_balls = 1000;
   std::uint32_t max_balls = 0;  // 0: the tank's capacity

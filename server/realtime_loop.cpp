@@ -3,33 +3,33 @@
 #include <chrono>
 #include <thread>
 
-#include "server/thread_tuner.h"
-
 namespace fishtank {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-// Past this much lag the loop stops trying to catch up and runs in slow motion
-// instead, rather than stalling everything in a burst of catch-up steps.
-constexpr double kMaxLagSeconds = 0.25;
+// A hiccup shorter than this is caught up on (in batches that each keep to
+// the budget); past it the loop lets simulated time slip: slow motion.
+constexpr double kMaxLagSeconds = 0.05;
 // How long before a batch the workers are woken: enough for a sleeping thread
-// to be scheduled on this virtual machine, well inside the pool's 1 ms of polling.
+// to be scheduled, well inside the pool's 1 ms of polling.
 constexpr double kWakeLeadSeconds = 0.0003;
+
+double seconds_between(Clock::time_point from, Clock::time_point to) {
+  return std::chrono::duration<double>(to - from).count();
+}
 }  // namespace
 
 void run_realtime(World& world, const LoopOptions& options, const std::atomic<bool>& stop) {
   const double dt = world.dt();
   const Clock::time_point start = Clock::now();
-  double sim_clock = 0.0;  // simulated seconds owed to the wall clock so far
+  double sim_clock = 0.0;  // wall seconds of simulated time stepped so far
   LoopStatus status;
   Clock::time_point window_start = start;
   std::uint64_t window_steps = 0;
   double window_busy = 0.0;
-  ThreadTuner tuner(world.threads());
-  world.set_thread_limit(tuner.threads());
 
   while (!stop.load(std::memory_order_relaxed)) {
-    const double now = std::chrono::duration<double>(Clock::now() - start).count();
+    const double now = seconds_between(start, Clock::now());
     if (options.duration > 0.0 && now >= options.duration) break;
     if (now - sim_clock > kMaxLagSeconds) {
       status.dropped_steps += static_cast<std::uint64_t>((now - sim_clock - kMaxLagSeconds) / dt);
@@ -37,19 +37,24 @@ void run_realtime(World& world, const LoopOptions& options, const std::atomic<bo
     }
     const Clock::time_point busy_start = Clock::now();
     if (options.at_step_boundary) options.at_step_boundary(world, status);
+    // Steps are due up to `now`, but the batch stops at its budget so that
+    // snapshots, status and commands keep their rate whatever a step costs.
+    const Clock::time_point budget_end =
+        busy_start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.batch_seconds));
     std::uint64_t batch_steps = 0;
-    for (; sim_clock + dt <= now; sim_clock += dt, ++batch_steps) world.step();
+    for (; sim_clock + dt <= now && (batch_steps == 0 || Clock::now() < budget_end); sim_clock += dt, ++batch_steps)
+      world.step();
     const Clock::time_point busy_end = Clock::now();
-    const double busy = std::chrono::duration<double>(busy_end - busy_start).count();
+    const double busy = seconds_between(busy_start, busy_end);
     window_busy += busy;
     window_steps += batch_steps;
-    world.set_thread_limit(tuner.record(busy, batch_steps, std::chrono::duration<double>(busy_end - start).count()));
-    status.threads = world.thread_limit();
+    status.threads = world.stepping_threads();
 
-    const double window = std::chrono::duration<double>(busy_end - window_start).count();
+    const double window = seconds_between(window_start, busy_end);
     if (window >= options.status_interval) {
       status.steps_per_s = window_steps / window;
       status.load = window_busy / window;
+      status.time_scale = window_steps * dt / window;
       if (options.on_status) options.on_status(world, status);
       window_start = busy_end;
       window_steps = 0;
@@ -58,10 +63,9 @@ void run_realtime(World& world, const LoopOptions& options, const std::atomic<bo
     }
     // Sleep until a batch of steps is due rather than a single one, and wake
     // the worker threads a little before it: waking a sleeping thread costs
-    // tens to hundreds of microseconds on a virtual machine, which the batch
-    // would otherwise wait for.
+    // more than the batch would otherwise wait for.
     const double next_batch = sim_clock + std::max(dt, options.batch_seconds);
-    const double wait = next_batch - std::chrono::duration<double>(Clock::now() - start).count();
+    const double wait = next_batch - seconds_between(start, Clock::now());
     if (wait > kWakeLeadSeconds) std::this_thread::sleep_for(std::chrono::duration<double>(wait - kWakeLeadSeconds));
     world.wake_workers();
     if (wait > 0.0)

@@ -25,6 +25,7 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   const PhaseSeconds before = world.phase_seconds();
   const std::uint64_t rebuilds_before = world.rebuilds(), kept_before = world.lists_kept_far();
   world.reset_thread_shares();
+  const std::uint64_t one_thread_before = world.steps_on_one_thread();
   // A shared machine's noise comes in bursts: timing several windows and
   // reporting the median keeps one burst from deciding the figure.
   const std::uint32_t windows = static_cast<std::uint32_t>(std::clamp<std::uint64_t>(spec.windows, 1, spec.steps));
@@ -57,6 +58,8 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   j["simd"] = world.kernels().simd;
   j["threads"] = world.threads();
   j["thread_shares"] = world.thread_shares();  // of the items the timed steps' passes computed
+  // The thread tuner's choice: the fraction of the timed steps taken on one thread.
+  j["one_thread_step_fraction"] = double(world.steps_on_one_thread() - one_thread_before) / std::max<std::uint64_t>(1, spec.steps);
   j["balls"] = world.ball_count();
   j["steps"] = spec.steps;
   j["seconds"] = seconds;

@@ -107,8 +107,6 @@ class WorkerPool {
   std::atomic<bool> stopping_{false};
   boost::mutex mutex_;
   boost::condition_variable wake_;
-  boost::mutex done_mutex_;
-  boost::condition_variable done_;
 };
 
 }  // namespace fishtank

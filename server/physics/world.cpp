@@ -380,7 +380,33 @@ bool World::lists_hold() {
   return true;
 }
 
+void World::set_thread_tuning(bool on) {
+  if (!on) {
+    tuner_.reset();
+    return;
+  }
+  tuner_.emplace(pool_.threads());
+  tuner_epoch_ = std::chrono::steady_clock::now();
+  set_thread_limit(tuner_->threads());
+}
+
+int World::stepping_threads() const { return tuner_ ? tuner_->chosen() : pool_.active_limit(); }
+
 void World::step() {
+  one_thread_steps_ += pool_.active_limit() == 1;
+  if (!tuner_) {
+    advance();
+    return;
+  }
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
+  advance();
+  const Clock::time_point end = Clock::now();
+  const auto seconds = [](Clock::duration d) { return std::chrono::duration<double>(d).count(); };
+  set_thread_limit(tuner_->record(seconds(end - start), 1, seconds(end - tuner_epoch_)));
+}
+
+void World::advance() {
   if (spawner_.pending() > 0 && steps_ % kSpawnInterval == 0) spawn();
   if (needs_initial_forces_) start_from_current_state();
 

@@ -22,7 +22,9 @@
 // Ball arrays are reordered by every rebuild; id() gives each ball's
 // permanent number (its order of appearance) for anyone who tracks balls.
 
+#include <chrono>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +34,7 @@
 #include "server/physics/kernels.h"
 #include "server/physics/params.h"
 #include "server/physics/spawner.h"
+#include "server/physics/thread_tuner.h"
 #include "server/physics/worker_pool.h"
 
 namespace fishtank {
@@ -108,6 +111,12 @@ class World {
   // Steps use at most this many of the threads (results do not depend on it).
   void set_thread_limit(int limit) { pool_.set_active_limit(limit); }
   int thread_limit() const { return pool_.active_limit(); }
+  // Lets each step choose between every thread and one by measurement, as the
+  // machine's load changes (ThreadTuner); off by default.
+  void set_thread_tuning(bool on);
+  // The threads the steps use: the tuner's choice between its probes.
+  int stepping_threads() const;
+  std::uint64_t steps_on_one_thread() const { return one_thread_steps_; }
   // Each thread's fraction of the items of every pass since reset_thread_shares().
   std::vector<double> thread_shares() const { return pool_.shares(); }
   void reset_thread_shares() { pool_.reset_shares(); }
@@ -165,12 +174,15 @@ class World {
   bool beyond_cache() const { return n_ >= kBeyondCacheBalls; }
   static constexpr std::uint32_t kBeyondCacheBalls = 32768;
   void derive_velocities() const;
+  void advance();  // one step, untimed
   void add_edge_fetches(StepArrays& s, std::uint32_t begin, std::uint32_t end) const;
 
   PhysicsParams params_;
   ContactModel model_;
   const Kernels& kernels_;
   WorkerPool pool_;
+  std::optional<ThreadTuner> tuner_;
+  std::chrono::steady_clock::time_point tuner_epoch_;
   Spawner spawner_;
   NeighbourList list_;
 
@@ -231,6 +243,7 @@ class World {
   double time_ = 0.0;
   double energy_added_ = 0.0;
   std::uint64_t steps_ = 0;
+  std::uint64_t one_thread_steps_ = 0;
   std::uint64_t rebuilds_ = 0;
   std::uint64_t lists_kept_far_ = 0;
   std::uint64_t far_checked_ = 0;

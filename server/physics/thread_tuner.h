@@ -1,0 +1,63 @@
+#pragma once
+// Picks how many worker threads a world steps with, by measurement.
+//
+// On a quiet machine every core helps. On a busy one a worker the OS
+// preempts inside its chunk holds up the whole pass until it runs again, and
+// paced steps start after the workers have slept: then one thread can step
+// faster than all. The balance moves from moment to moment, so the tuner
+// keeps a running estimate of the cost of a step on every thread and on one,
+// steps with the cheaper, and now and then times a few steps with the other
+// (a probe). Each estimate forgets with a time constant of kTimeConstant
+// seconds, so a change of load changes the choice within about half a second.
+// Results never depend on the thread count (the state is bit-identical), so
+// switching is invisible except in the speed.
+
+#include <cstdint>
+
+namespace fishtank {
+
+class ThreadTuner {
+ public:
+  static constexpr double kTimeConstant = 0.1;
+  // Seconds between probes while the two counts cost about the same; up to
+  // kMaxProbeBackoff times longer while the other is that much dearer, so a
+  // count that stalls (many busy processes) is rarely tried.
+  static constexpr double kProbeSeconds = 0.1;
+  static constexpr double kMaxProbeBackoff = 5.0;
+  // A probe lasts until it has measured this much stepping.
+  static constexpr double kProbeBusySeconds = 0.001;
+  // The other count must be this much cheaper to be chosen, so that two
+  // nearly equal estimates do not swap the choice back and forth.
+  static constexpr double kHysteresis = 0.05;
+
+  explicit ThreadTuner(int max_threads);
+
+  // Records steps done: wall seconds spent stepping, steps, and the wall clock
+  // (seconds) at their end. Returns the thread count for the next steps.
+  int record(double busy_seconds, std::uint64_t steps, double now);
+  // The count the next steps use.
+  int threads() const { return threads_; }
+  // The count the estimates favour (threads() differs from it during a probe).
+  int chosen() const { return chosen_; }
+
+ private:
+  // Seconds per step, averaged over the last kTimeConstant seconds or so.
+  struct Estimate {
+    double cost = 0.0;
+    double at = 0.0;  // wall clock of the last sample it took in
+    bool measured = false;
+    void add(double sample, double now);
+  };
+  Estimate& estimate(int threads) { return threads == 1 ? one_ : all_; }
+  int other() const { return chosen_ == 1 ? max_threads_ : 1; }
+
+  int max_threads_;
+  int chosen_;
+  int threads_;
+  double last_probe_ = 0.0;
+  double probe_busy_ = 0.0;  // the running probe's stepping so far
+  std::uint64_t probe_steps_ = 0;
+  Estimate one_, all_;
+};
+
+}  // namespace fishtank

@@ -1,0 +1,80 @@
+// The paced loop keeps calling back between batches at the snapshot rate
+// whatever a step costs: a world far over its real-time budget runs in slow
+// motion and says so, and one within it keeps real time.
+
+#include "server/realtime_loop.h"
+
+#include <algorithm>
+#include <atomic>
+#include <catch2/catch.hpp>
+#include <chrono>
+#include <vector>
+
+using namespace fishtank;
+
+namespace {
+
+struct Observed {
+  double boundaries_per_s = 0.0;  // at_step_boundary calls, where snapshots go out
+  std::vector<double> time_scales;
+  double sim_seconds = 0.0;
+};
+
+Observed run_paced(World& world, double seconds) {
+  LoopOptions options;
+  options.duration = seconds;
+  options.status_interval = 0.25;
+  Observed seen;
+  int boundaries = 0;
+  options.at_step_boundary = [&](World&, const LoopStatus&) { ++boundaries; };
+  options.on_status = [&](const World&, const LoopStatus& s) { seen.time_scales.push_back(s.time_scale); };
+  const double sim_before = world.time();
+  const auto start = std::chrono::steady_clock::now();
+  const std::atomic<bool> stop{false};
+  run_realtime(world, options, stop);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  seen.boundaries_per_s = boundaries / wall;
+  seen.sim_seconds = world.time() - sim_before;
+  return seen;
+}
+
+PhysicsParams with_stiffness(float stiffness) {
+  PhysicsParams params;
+  params.stiffness = stiffness;
+  return params;
+}
+
+// `balls` in a lattice, at rest.
+void place_lattice(World& world, int balls) {
+  for (int b = 0; b < balls; ++b)
+    world.place_ball(b % kKindCount, {-18.5f + 3.1f * (b % 12), 1.6f + 3.1f * (b / 144), -18.5f + 3.1f * ((b / 12) % 12)},
+                     {0.0f, 0.0f, 0.0f});
+}
+
+}  // namespace
+
+TEST_CASE("a world far over its real-time budget runs in slow motion, and the loop keeps its rate",
+          "[server][loop]") {
+  // Stiff contacts make dt tiny: real time would need far more steps per second than one thread runs.
+  World world(with_stiffness(1e9f), kSseKernels, 1, 5);
+  place_lattice(world, 1500);
+  const Observed seen = run_paced(world, 1.5);
+  INFO("dt " << world.dt() << " s, " << seen.boundaries_per_s << " batches/s, simulated " << seen.sim_seconds << " s");
+  // Each batch keeps to its budget (4 ms), so the loop comes round at least 30 times a second.
+  CHECK(seen.boundaries_per_s >= 30.0);
+  REQUIRE(seen.time_scales.size() >= 3);
+  const double last = seen.time_scales.back();
+  CHECK(last > 0.0);
+  CHECK(last < 0.8);
+  // The time scale reported is the simulated time the loop advanced.
+  CHECK(seen.sim_seconds < 0.9 * 1.5);
+}
+
+TEST_CASE("a world within its budget keeps real time", "[server][loop]") {
+  World world(with_stiffness(25000.0f), kSseKernels, 1, 5);
+  place_lattice(world, 100);
+  const Observed seen = run_paced(world, 1.0);
+  REQUIRE(seen.time_scales.size() >= 3);
+  CHECK(seen.time_scales.back() == Approx(1.0).margin(0.1));
+  CHECK(seen.sim_seconds == Approx(1.0).margin(0.1));
+}
