@@ -84,6 +84,7 @@ void Connection::handle(const wire::Message& message) {
       const wire::Welcome& w = *message.payload_as_Welcome();
       welcomed_ = true;
       if (w.has_player()) player_id_ = w.player_id();
+      worker_threads_ = w.worker_threads();
       tank_.min = {w.tank_min()->x(), w.tank_min()->y(), w.tank_min()->z()};
       tank_.max = {w.tank_max()->x(), w.tank_max()->y(), w.tank_max()->z()};
       break;
@@ -105,6 +106,10 @@ void Connection::handle(const wire::Message& message) {
                                 std::to_string(view_.kinds.size()) + " were sent");
       view_.tick = s.tick();
       view_.sim_time = s.sim_time();
+      view_.steps_per_s = s.steps_per_s();
+      view_.load = s.load();
+      view_.threads_stepping = s.threads_stepping();
+      view_.time_scale = s.time_scale();
       view_.ball_count = s.ball_count();
       const std::size_t common = std::min<std::size_t>(view_.positions.size(), s.positions()->size()) / 3;
       std::size_t at_rest = 0, small = 0;

@@ -36,6 +36,10 @@ struct ConnectionStats {
 struct WorldView {
   std::uint32_t tick = 0;
   double sim_time = 0.0;
+  float steps_per_s = 0.0f;
+  float load = 0.0f;
+  std::uint32_t threads_stepping = 0;  // 0: the server did not say
+  float time_scale = 0.0f;             // simulated seconds per wall second; 0: the server did not say
   std::uint32_t ball_count = 0;
   std::vector<std::uint16_t> positions;  // quantised, 3 per ball (protocol/quantize.h)
   std::vector<std::uint8_t> kinds;       // by ball id, from BallKinds
@@ -57,6 +61,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
   bool closed() const { return closed_; }
   const std::string& close_reason() const { return close_reason_; }
   std::optional<std::uint32_t> player_id() const { return player_id_; }
+  std::uint32_t worker_threads() const { return worker_threads_; }  // from Welcome: the most a step may use
   const TankBounds& tank() const { return tank_; }
   const ConnectionStats& stats() const { return stats_; }
   const WorldView& view() const { return view_; }
@@ -82,6 +87,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
   bool closed_ = false;
   std::string close_reason_;
   std::optional<std::uint32_t> player_id_;
+  std::uint32_t worker_threads_ = 0;
   TankBounds tank_;
   ConnectionStats stats_;
   WorldView view_;

@@ -1,5 +1,6 @@
 // fishtank-client: a scripted test and load client (see --help).
 
+#include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
@@ -26,6 +27,11 @@ int main(int argc, char** argv) {
                         {"bytes_per_s", s.bytes_per_s},
                         {"rtt_ms", s.rtt_ms},
                         {"balls", s.balls},
+                        {"steps_per_s", s.steps_per_s},
+                        {"load", s.load},
+                        {"threads_stepping", s.threads_stepping},
+                        {"worker_threads", s.worker_threads},
+                        {"time_scale", s.time_scale},
                         {"at_rest_fraction", s.at_rest_fraction},
                         {"int8_delta_fraction", s.int8_delta_fraction},
                         {"errors", s.error_messages.size()},
@@ -34,7 +40,9 @@ int main(int argc, char** argv) {
   } else {
     std::cout << s.welcomed << " of " << s.clients << " clients welcomed; " << s.snapshots << " snapshots ("
               << s.snapshot_rate_hz << " Hz and " << s.bytes_per_s / 1e3 << " kB/s per client); rtt " << s.rtt_ms
-              << " ms; " << s.balls << " balls\n";
+              << " ms; " << s.balls << " balls; server " << std::lround(s.steps_per_s) << " steps/s, load "
+              << std::lround(100.0 * s.load) << " % on " << s.threads_stepping << " of " << s.worker_threads
+              << " threads, time scale " << s.time_scale << "\n";
     for (const std::string& e : s.error_messages) std::cout << "error: " << e << "\n";
   }
   return 0;

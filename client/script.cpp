@@ -38,6 +38,11 @@ Summary summarise(const std::vector<std::shared_ptr<Connection>>& connections, d
     if (st.snapshots > 0 && c->view().tick >= newest_tick) {
       newest_tick = c->view().tick;
       s.balls = c->view().ball_count;
+      s.steps_per_s = c->view().steps_per_s;
+      s.load = c->view().load;
+      s.threads_stepping = c->view().threads_stepping;
+      s.time_scale = c->view().time_scale;
+      s.worker_threads = c->worker_threads();
       s.at_rest_fraction = st.at_rest_fraction;
       s.int8_delta_fraction = st.int8_delta_fraction;
     }

@@ -27,11 +27,17 @@ struct Script {
 struct Summary {
   int clients = 0;
   int welcomed = 0;
-  std::uint64_t snapshots = 0;       // total over all clients
-  double snapshot_rate_hz = 0.0;     // mean per client
-  double bytes_per_s = 0.0;          // mean per client
-  double rtt_ms = 0.0;               // median over every Pong; 0 without any
-  std::uint32_t balls = 0;           // newest ball count seen
+  std::uint64_t snapshots = 0;    // total over all clients
+  double snapshot_rate_hz = 0.0;  // mean per client
+  double bytes_per_s = 0.0;       // mean per client
+  double rtt_ms = 0.0;            // median over every Pong; 0 without any
+  std::uint32_t balls = 0;        // newest ball count seen
+  // The server's figures in that newest snapshot, and Welcome's worker threads.
+  double steps_per_s = 0.0;
+  double load = 0.0;
+  std::uint32_t threads_stepping = 0;  // 0: not reported
+  std::uint32_t worker_threads = 0;
+  double time_scale = 0.0;           // simulated seconds per wall second; 0: not reported
   double at_rest_fraction = 0.0;     // in that newest snapshot (ConnectionStats::at_rest_fraction)
   double int8_delta_fraction = 0.0;  // likewise (ConnectionStats::int8_delta_fraction)
   std::vector<std::string> error_messages;

@@ -103,8 +103,9 @@ std::string check_values(const wire::Message& m) {
         return "Snapshot player_ids and player_positions differ in length";
       for (const wire::Vec3f* p : *s.player_positions())
         if (!finite(p)) return "Snapshot has a non-finite player position";
-      if (!std::isfinite(s.sim_time()) || !std::isfinite(s.steps_per_s()) || !std::isfinite(s.load()))
-        return "Snapshot has a non-finite time, rate or load";
+      if (!std::isfinite(s.sim_time()) || !std::isfinite(s.steps_per_s()) || !std::isfinite(s.load()) ||
+          !std::isfinite(s.time_scale()))
+        return "Snapshot has a non-finite time, rate, load or time scale";
       return {};
     }
     case wire::Payload::Error:
@@ -169,8 +170,9 @@ Frame encode_snapshot(const SnapshotHeader& header, const std::uint16_t* quantis
   std::vector<wire::Vec3f> player_wire(players);
   for (std::size_t i = 0; i < players; ++i) player_wire[i] = to_wire(player_positions[i]);
   const auto player_offset = b.CreateVectorOfStructs(player_wire);
-  return finish(b, wire::CreateSnapshot(b, header.tick, header.sim_time, header.physics_steps, header.steps_per_s,
-                                        header.load, ball_count, positions, ids, player_offset));
+  return finish(
+      b, wire::CreateSnapshot(b, header.tick, header.sim_time, header.physics_steps, header.steps_per_s, header.load,
+                              ball_count, positions, ids, player_offset, header.threads_stepping, header.time_scale));
 }
 
 Frame encode_error(wire::ErrorCode code, std::string_view message) {

@@ -76,6 +76,8 @@ struct SnapshotHeader {
   std::uint32_t physics_steps = 0;
   float steps_per_s = 0.0f;
   float load = 0.0f;
+  std::uint32_t threads_stepping = 0;  // 0: not reported
+  float time_scale = 0.0f;             // simulated seconds per wall second; 0: not reported
 };
 // quantised holds 3 * ball_count values (protocol/quantize.h), in ball-id order;
 // player_ids and player_positions hold `players` entries each.

@@ -8,8 +8,10 @@
 #include <atomic>
 #include <cstdio>
 #include <iostream>
+#include <string>
 
 #include "common/fp_env.h"
+#include "common/time_scale.h"
 #include "server/bench/benchmark.h"
 #include "server/bench/scenes.h"
 #include "server/export/csv_dump.h"
@@ -53,6 +55,7 @@ int write_final_state(const fishtank::World& world, const fishtank::ServerOption
 
 int run_bench(const fishtank::ServerOptions& o) {
   fishtank::World world(o.physics, kKernels, o.threads, o.bench_spec.scene.seed);
+  world.set_thread_tuning(!o.fixed_threads);
   if (std::string refusal = fishtank::populate(world, o.bench_spec.scene); !refusal.empty()) {
     std::cerr << "fishtank-server: " << refusal << "\n";
     return 2;
@@ -65,6 +68,24 @@ int run_bench(const fishtank::ServerOptions& o) {
   nlohmann::json report = fishtank::time_steps(world, o.bench_spec, settled);
   std::cout << report.dump(2) << std::endl;
   return write_final_state(world, o);
+}
+
+// "2 threads", or "3 threads on 2 cores: oversubscribed": more threads than
+// cores is allowed, but then they take turns and the figures should say so.
+std::string threads_text(int threads, int cores) {
+  std::string text = std::to_string(threads) + (threads == 1 ? " thread" : " threads");
+  if (threads > cores) text += " on " + std::to_string(cores) + (cores == 1 ? " core" : " cores") + ": oversubscribed";
+  return text;
+}
+
+// Nothing while simulated time keeps up with the wall clock.
+std::string pace_text(const fishtank::LoopStatus& s) {
+  if (fishtank::slow_motion(s.time_scale)) {
+    char text[48];
+    std::snprintf(text, sizeof text, "  slow motion x%.2f", s.time_scale);
+    return text;
+  }
+  return s.dropped_steps ? "  (falling behind real time)" : "";
 }
 
 fishtank::net::NetOptions net_options(const fishtank::ServerOptions& o) {
@@ -90,14 +111,16 @@ fishtank::net::ServerInfo server_info(const fishtank::World& world, const fishta
 int run_server(const fishtank::ServerOptions& o) {
   spdlog::set_default_logger(spdlog::stderr_logger_mt("fishtank-server"));
   fishtank::World world(o.physics, kKernels, o.threads, o.bench_spec.scene.seed);
+  world.set_thread_tuning(!o.fixed_threads);
   if (o.max_balls > 0) world.set_max_balls(o.max_balls);
   if (o.start_balls > 0) {
     fishtank::AddResult added = world.add_balls(o.start_balls);
     if (!added.refusal.empty()) std::cerr << "fishtank-server: " << added.refusal << "\n";
   }
-  std::fprintf(stderr, "fishtank-server (%s, %s, %d threads): dt = %.3g s, k = %g N/m, e = %g; Ctrl-C stops\n",
-               kKernels.variant, kKernels.simd, world.threads(), world.dt(), o.physics.stiffness,
-               o.physics.restitution);
+  const int cores = fishtank::WorkerPool::hardware_threads();
+  std::fprintf(stderr, "fishtank-server (%s, %s, %s): dt = %.3g s, k = %g N/m, e = %g; Ctrl-C stops\n",
+               kKernels.variant, kKernels.simd, threads_text(world.threads(), cores).c_str(), world.dt(),
+               o.physics.stiffness, o.physics.restitution);
   fishtank::net::NetworkService network(net_options(o), server_info(world, o), g_stop);
   if (std::string error = network.start(); !error.empty()) {
     std::cerr << "fishtank-server: " << error << "\n";
@@ -121,11 +144,10 @@ int run_server(const fishtank::ServerOptions& o) {
     if (std::string error = recorder.write_frame(w); !error.empty()) spdlog::error("{}", error);
     next_frame = w.steps() + o.record_every;
   };
-  loop.on_status = [&network](const fishtank::World& w, const fishtank::LoopStatus& s) {
-    std::fprintf(stderr, "t = %7.1f s  balls %5u (+%u queued)  %6.0f steps/s  load %5.1f %% on %d thread%s  %s%s\n",
-                 w.time(), w.ball_count(), w.pending(), s.steps_per_s, 100.0 * s.load, s.threads,
-                 s.threads == 1 ? "" : "s", network.status().c_str(),
-                 s.dropped_steps ? "  (falling behind real time)" : "");
+  loop.on_status = [&network, cores](const fishtank::World& w, const fishtank::LoopStatus& s) {
+    std::fprintf(stderr, "t = %7.1f s  balls %5u (+%u queued)  %6.0f steps/s  load %5.1f %% on %s  %s%s\n", w.time(),
+                 w.ball_count(), w.pending(), s.steps_per_s, 100.0 * s.load, threads_text(s.threads, cores).c_str(),
+                 network.status().c_str(), pace_text(s).c_str());
   };
   fishtank::run_realtime(world, loop, g_stop);
   std::cerr << "fishtank-server: stopped after " << world.steps() << " steps, " << world.ball_count() << " balls\n";

@@ -73,6 +73,8 @@ void PhysicsLink::publish_snapshot(const World& world, const LoopStatus& status)
   header.physics_steps = static_cast<std::uint32_t>(world.steps());
   header.steps_per_s = static_cast<float>(status.steps_per_s);
   header.load = static_cast<float>(status.load);
+  header.threads_stepping = static_cast<std::uint32_t>(status.threads);
+  header.time_scale = static_cast<float>(status.time_scale);
   SharedSnapshot snapshot = encoder_.encode(world, header);
   stats_.last_frame_bytes = snapshot->frame->size();
   stats_.encode_seconds += std::chrono::duration<double>(Clock::now() - start).count();

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "common/fp_env.h"
+#include "server/physics/player_spawn.h"
 
 namespace fishtank {
 
@@ -102,9 +103,9 @@ void World::place_ball(int kind, Vec3 p, Vec3 v) {
 
 std::uint32_t World::add_player() {
   std::uint32_t id = next_player_id_++;
-  Vec3 centre = params_.tank.min + params_.tank.size() * 0.5f;
+  const Vec3 at = choose_player_spawn(params_.tank, player_pos_.data(), player_pos_.size(), pos_.data(), n_);
   player_ids_.push_back(id);
-  player_pos_.push_back({centre.x, centre.y, centre.z, 0.5f * kPlayerDiameter});
+  player_pos_.push_back({at.x, at.y, at.z, 0.5f * kPlayerDiameter});
   player_vel_.push_back({});
   return id;
 }

@@ -74,7 +74,8 @@ class World {
   void place_ball(int kind, Vec3 pos, Vec3 vel);
   void set_max_balls(std::uint32_t max_balls) { max_balls_ = max_balls; }
 
-  // Kinematic player spheres; ids are never reused.
+  // Kinematic player spheres; ids are never reused. Each starts at a free point
+  // near the centre, apart from the others (choose_player_spawn).
   std::uint32_t add_player();
   bool remove_player(std::uint32_t id);
   // Desired velocity, clamped to the maximum player speed. False if non-finite or unknown id.

@@ -59,12 +59,16 @@ TEST_CASE("every message survives encode then decode with its values intact", "[
     protocol::SnapshotHeader h;
     h.tick = 12;
     h.sim_time = 3.5;
+    h.threads_stepping = 3;
+    h.time_scale = 0.42f;
     const protocol::Frame f = protocol::encode_snapshot(h, q.data(), 2, ids, players, 2);
     const auto r = decode(f, Direction::to_client);
     REQUIRE(r.ok());
     const wire::Snapshot& s = *r.message->payload_as_Snapshot();
     CHECK(s.tick() == 12);
     CHECK(s.sim_time() == 3.5);
+    CHECK(s.threads_stepping() == 3);
+    CHECK(s.time_scale() == 0.42f);
     CHECK(std::vector<std::uint16_t>(s.positions()->begin(), s.positions()->end()) == q);
     CHECK(s.player_ids()->Get(1) == 9);
     CHECK(s.player_positions()->Get(1)->z() == -6.0f);
@@ -150,6 +154,13 @@ TEST_CASE("frames a peer got wrong are refused with a status that says whether t
     const auto snapshot = wire::CreateSnapshot(b, 0, 0.0, 0, 0.0f, 0.0f, /*ball_count=*/0);
     b.FinishSizePrefixed(wire::CreateMessage(b, wire::Payload::Snapshot, snapshot.Union()), "FTNK");
     const protocol::Frame f(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize());
+    CHECK(decode(f, Direction::to_client).status == DecodeStatus::invalid_value);
+  }
+  SECTION("a snapshot whose time scale is not finite is invalid") {
+    protocol::SnapshotHeader h;
+    h.time_scale = std::numeric_limits<float>::quiet_NaN();
+    const std::uint16_t q[3] = {1, 2, 3};
+    const protocol::Frame f = protocol::encode_snapshot(h, q, 1, nullptr, nullptr, 0);
     CHECK(decode(f, Direction::to_client).status == DecodeStatus::invalid_value);
   }
   SECTION("a snapshot whose position count disagrees with its ball count is invalid") {

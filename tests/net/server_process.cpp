@@ -10,6 +10,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -39,8 +40,10 @@ ServerProcess::ServerProcess(const std::vector<std::string>& args) {
                   .string();
   // --duration: a server whose test was killed before its destructor ran still
   // stops by itself instead of running on as an orphan.
-  std::vector<std::string> argv_text{FISHTANK_SERVER_PATH, "--bind", "127.0.0.1", "--port", "0",
-                                     "--threads",          "1",      "--duration", "300"};
+  std::vector<std::string> argv_text{FISHTANK_SERVER_PATH, "--bind", "127.0.0.1", "--port", "0", "--duration", "300"};
+  // The server refuses a flag given twice.
+  if (std::find(args.begin(), args.end(), "--threads") == args.end())
+    argv_text.insert(argv_text.end(), {"--threads", "1"});
   argv_text.insert(argv_text.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (std::string& a : argv_text) argv.push_back(a.data());

@@ -14,8 +14,8 @@ namespace fishtank::test {
 
 class ServerProcess {
  public:
-  // Starts fishtank-server --bind 127.0.0.1 --port 0 --threads 1 plus `args`,
-  // and waits (at most 15 s) until it listens. Throws when it does not.
+  // Starts fishtank-server --bind 127.0.0.1 --port 0 plus `args` (and --threads 1
+  // unless they give --threads), and waits (at most 15 s) until it listens. Throws when it does not.
   explicit ServerProcess(const std::vector<std::string>& args);
   // SIGKILL if still running.
   ~ServerProcess();

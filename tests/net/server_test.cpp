@@ -8,6 +8,8 @@
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <string>
+#include <thread>
 #include <vector>
 
 #include "client/connection.h"
@@ -114,6 +116,53 @@ TEST_CASE("several clients each receive snapshots at the snapshot rate and the s
   CHECK(all[0]->player_id().has_value());
   CHECK_FALSE(all[1]->player_id().has_value());  // observers get no sphere
   CHECK(server.terminate() == 0);
+}
+
+TEST_CASE("every snapshot says how many threads step, at most Welcome's worker threads, and how fast time runs",
+          "[net]") {
+  ServerProcess server({"--balls", "500", "--threads", "2", "--status-interval", "0.5"});
+  Clients clients(server.port());
+  auto c = clients.add(false);
+  REQUIRE(clients.wait_until([&] { return c->welcomed(); }, std::chrono::seconds(5)));
+  CHECK(c->worker_threads() == 2);
+  // Past two status intervals, so the figures are measured ones.
+  clients.run_for(std::chrono::milliseconds(1200));
+  REQUIRE(c->stats().snapshots > 0);
+
+  const Clock::time_point start = Clock::now();
+  const double sim_start = c->view().sim_time;
+  std::uint32_t tick = c->view().tick;
+  int seen = 0;
+  double scale_sum = 0.0;
+  while (Clock::now() - start < std::chrono::milliseconds(1500)) {
+    clients.run_for(std::chrono::milliseconds(10));
+    const client::WorldView& v = c->view();
+    if (v.tick == tick) continue;
+    tick = v.tick;
+    ++seen;
+    scale_sum += v.time_scale;
+    INFO("snapshot " << v.tick << ": " << v.threads_stepping << " threads stepping, time scale " << v.time_scale);
+    CHECK(v.threads_stepping >= 1);
+    CHECK(v.threads_stepping <= c->worker_threads());
+    CHECK(v.time_scale > 0.0f);
+    CHECK(v.time_scale <= 1.05f);
+  }
+  REQUIRE(seen > 10);
+  // What the server reports is what a client sees: simulated seconds per wall second.
+  const double observed =
+      (c->view().sim_time - sim_start) / std::chrono::duration<double>(Clock::now() - start).count();
+  CHECK(scale_sum / seen == Approx(observed).margin(0.25));
+}
+
+TEST_CASE("more threads than cores are allowed, and the server says they are oversubscribed", "[net]") {
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const std::string threads = std::to_string(std::max(8u, 2 * cores));
+  ServerProcess server({"--balls", "0", "--threads", threads});
+  Clients clients(server.port());
+  auto c = clients.add(false);
+  REQUIRE(clients.wait_until([&] { return c->stats().snapshots > 0; }, std::chrono::seconds(5)));
+  CHECK(std::to_string(c->worker_threads()) == threads);
+  CHECK_THAT(server.log(), Catch::Contains(threads + " threads on ") && Catch::Contains(": oversubscribed"));
 }
 
 TEST_CASE("AddBalls raises the ball count that every client sees - beyond room it gets an Error saying why", "[net]") {
@@ -316,4 +365,32 @@ TEST_CASE("clients that never read: the server's memory stays bounded and others
   CHECK(rate > 300.0);  // 400 Hz asked
   CHECK(server.running());
   CHECK(watcher->stats().errors.empty());
+}
+
+TEST_CASE("players who join together start apart, not as one sphere", "[net]") {
+  ServerProcess server({"--balls", "0"});
+  Clients clients(server.port());
+  std::vector<std::shared_ptr<Connection>> players;
+  for (int i = 0; i < 3; ++i) players.push_back(clients.add(true));
+  REQUIRE(clients.wait_until([&] { return players[0]->view().player_ids.size() == 3; }, std::chrono::seconds(5)));
+  const std::vector<Vec3>& at = players[0]->view().player_positions;
+  for (std::size_t i = 0; i < at.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j) CHECK(length(at[i] - at[j]) >= kPlayerDiameter);
+}
+
+TEST_CASE("physics far over its real-time budget: observers keep their snapshot rate and are told of slow motion",
+          "[net]") {
+  // Stiff contacts resolved over 100 steps make dt tiny: real time would need
+  // several times the steps per second one thread runs.
+  ServerProcess server({"--balls", "2000", "--stiffness", "1e9", "--steps-per-contact", "100"});
+  Clients clients(server.port());
+  auto observer = clients.add(false);
+  REQUIRE(clients.wait_until([&] { return observer->view().ball_count > 500; }, std::chrono::seconds(15)));
+  clients.run_for(std::chrono::milliseconds(1500));  // a status interval: the time scale is measured
+  const double rate = measure_rates(clients, {observer}, 2.0).front();
+  CHECK(rate >= 30.0);  // 60 Hz asked; before the budget, about one a second
+  const float scale = observer->view().time_scale;
+  CHECK(scale > 0.0f);
+  CHECK(scale < 0.9f);
+  CHECK(server.running());
 }
