@@ -28,7 +28,8 @@ int ThreadTuner::record(double busy_seconds, std::uint64_t steps, double now) {
     if (probe_busy_ < kProbeBusySeconds) return threads_;
     estimate(threads_).add(probe_busy_ / probe_steps_, now);
   }
-  if (one_.measured && all_.measured && estimate(other()).cost < (1.0 - kHysteresis) * estimate(chosen_).cost)
+  const double margin = other() == 1 ? kHysteresisToOne : kHysteresisToAll;
+  if (one_.measured && all_.measured && estimate(other()).cost < (1.0 - margin) * estimate(chosen_).cost)
     chosen_ = other();
   threads_ = chosen_;
   const double backoff =

@@ -27,8 +27,11 @@ class ThreadTuner {
   // A probe lasts until it has measured this much stepping.
   static constexpr double kProbeBusySeconds = 0.001;
   // The other count must be this much cheaper to be chosen, so that two
-  // nearly equal estimates do not swap the choice back and forth.
-  static constexpr double kHysteresis = 0.05;
+  // nearly equal estimates do not swap the choice back and forth. Going to
+  // every thread asks for more: on a busy machine their cost varies widely
+  // (a preempted worker stalls a pass), one thread's does not.
+  static constexpr double kHysteresisToOne = 0.05;
+  static constexpr double kHysteresisToAll = 0.15;
 
   explicit ThreadTuner(int max_threads);
 
