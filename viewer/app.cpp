@@ -6,11 +6,15 @@
 #include <malloc.h>
 #endif
 
+#include <chrono>
 #include <cstdio>
 #include <memory>
+#include <string>
+#include <thread>
 #include <vector>
 
 #include "viewer/clock.h"
+#include "viewer/frame_pacer.h"
 #include "viewer/frame_stats.h"
 #include "viewer/hud.h"
 #include "viewer/input.h"
@@ -111,6 +115,15 @@ int run_viewer(const ViewerOptions& opt) {
                  reinterpret_cast<const char*>(glewGetErrorString(err)));
     return 1;
   }
+  // The swap interval does nothing under Xvfb, so a cap of our own keeps a CPU
+  // renderer from drawing flat out on the cores it shares with the server.
+  const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  FramePacer pacer(choose_max_fps(opt.max_fps, renderer));
+  const std::string cap =
+      pacer.max_fps() > 0 ? "frames capped at " + std::to_string(pacer.max_fps()) + "/s" : "frames uncapped";
+  std::fprintf(stderr, "fishtank-viewer: %s (%s): %s; --max-fps changes it\n",
+               is_software_renderer(renderer) ? "software OpenGL" : "OpenGL", renderer ? renderer : "unknown",
+               cap.c_str());
   FullscreenToggle fullscreen(window);
   if (opt.fullscreen) fullscreen.toggle();
 
@@ -143,7 +156,8 @@ int run_viewer(const ViewerOptions& opt) {
       const double cpu_start = thread_cpu_seconds();
 
       Actions a = input.take_actions();
-      if (a.quit) glfwSetWindowShouldClose(window, GLFW_TRUE);
+      if (a.quit || (opt.duration > 0.0 && frame_start - started >= opt.duration))
+        glfwSetWindowShouldClose(window, GLFW_TRUE);
       if (a.toggle_tank) show_tank = !show_tank;
       if (a.toggle_help) show_help = !show_help;
       if (a.toggle_hud) show_stats = !show_stats;
@@ -212,6 +226,8 @@ int run_viewer(const ViewerOptions& opt) {
       }
       glfwSwapBuffers(window);
       stats.frame_done(steady_seconds(), cpu_seconds, have_frame);
+      if (const double sleep = pacer.sleep_seconds(steady_seconds()); sleep > 0.0)
+        std::this_thread::sleep_for(std::chrono::duration<double>(sleep));
     }
 
     const std::shared_ptr<const Snapshot> last = snapshots.newest();

@@ -20,6 +20,8 @@ struct ViewerOptions {
   std::string screenshot;     // non-empty: save this PNG after `frames` frames, then exit
   int frames = 1;
   double screenshot_timeout = 30.0;  // seconds to wait for the first snapshot
+  int max_fps = -1;                  // frames per second at most, 0 uncapped; -1: by renderer (frame_pacer.h)
+  double duration = 0.0;             // seconds until the viewer closes itself; 0: until closed
 };
 
 // Returns the process exit code.

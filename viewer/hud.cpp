@@ -7,6 +7,8 @@
 #include <cstdarg>
 #include <cstdio>
 
+#include "viewer/hud_text.h"
+
 namespace fishtank::viewer {
 namespace {
 
@@ -19,15 +21,19 @@ constexpr double kNoticeSeconds = 6.0;
 
 const ImVec4 kDim{0.65f, 0.70f, 0.78f, 1.0f};
 const ImVec4 kWarn{1.0f, 0.55f, 0.35f, 1.0f};
+const ImVec4 kStale{0.45f, 0.45f, 0.45f, 1.0f};
 
-void row(const char* label, const char* fmt, ...) IM_FMTARGS(2);
-void row(const char* label, const char* fmt, ...) {
-  ImGui::TextColored(kDim, "%s", label);
+// live false: label and figure both greyed, the figure being left over from a lost connection.
+void row(bool live, const char* label, const char* fmt, ...) IM_FMTARGS(3);
+void row(bool live, const char* label, const char* fmt, ...) {
+  ImGui::TextColored(live ? kDim : kStale, "%s", label);
   ImGui::SameLine(110.0f);
+  if (!live) ImGui::PushStyleColor(ImGuiCol_Text, kStale);
   va_list args;
   va_start(args, fmt);
   ImGui::TextV(fmt, args);
   va_end(args);
+  if (!live) ImGui::PopStyleColor();
 }
 
 }  // namespace
@@ -74,30 +80,40 @@ void Hud::stats(const HudView& v) {
   ImGui::Begin("stats", nullptr,
                ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
                    ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoMove);
-  row("Frames", "%.1f fps   %.2f ms/frame", v.fps, v.frame_ms);
-  row("CPU", "%.2f ms/frame outside GL", v.cpu_ms);
-  if (const Snapshot* s = v.snapshot) {
-    row("Physics", "%.0f steps/s   load %.0f %%", s->steps_per_s, 100.0f * s->load);
-    row("Balls", "%u", s->ball_count);
+  // The viewer's own figures stay live; everything the server or the link reported greys when the link drops.
+  row(true, "Frames", "%.1f fps   %.2f ms/frame", v.fps, v.frame_ms);
+  row(true, "CPU", "%.2f ms/frame outside GL", v.cpu_ms);
+  const Snapshot* s = v.snapshot;
+  const Freshness fresh =
+      figures_freshness(net.state == ConnectionStatus::State::connected, v.now, s ? s->received : -1.0);
+  const bool live = fresh.live;
+  if (s) {
+    row(live, "Physics", "%.0f steps/s   load %.0f %%", s->steps_per_s, 100.0f * s->load);
+    row(live, "Time", "%s", time_scale_text(s->time_scale).c_str());
+    row(live, "Balls", "%u", s->ball_count);
   } else {
-    row("Physics", "-");
-    row("Balls", "-");
+    row(live, "Physics", "-");
+    row(live, "Time", "-");
+    row(live, "Balls", "-");
   }
-  if (const ServerInfo* info = net.info.get())
-    row("Server", "%s (SIMD %s), %d worker thread%s", info->variant.c_str(), info->simd.c_str(),
-        info->threads, info->threads == 1 ? "" : "s");
-  else
-    row("Server", "%s", net.endpoint.c_str());
-  row("Snapshots", "%.1f /s   render delay %.0f ms", net.snapshots_per_s, v.render_delay_ms);
-  row("Bandwidth", "%.1f KiB/s in", net.bytes_per_s / 1024.0f);
+  if (const ServerInfo* info = net.info.get()) {
+    row(live, "Threads", "%s", threads_text(s ? s->threads_stepping : 0, info->threads).c_str());
+    row(live, "Server", "%s (SIMD %s)", info->variant.c_str(), info->simd.c_str());
+  } else {
+    row(live, "Threads", "-");
+    row(live, "Server", "%s", net.endpoint.c_str());
+  }
+  row(live, "Snapshots", "%.1f /s   render delay %.0f ms", net.snapshots_per_s, v.render_delay_ms);
+  row(live, "Bandwidth", "%.1f KiB/s in", net.bytes_per_s / 1024.0f);
   if (net.rtt_ms >= 0.0f)
-    row("Round trip", "%.2f ms", net.rtt_ms);
+    row(live, "Round trip", "%.2f ms", net.rtt_ms);
   else
-    row("Round trip", "-");
+    row(live, "Round trip", "-");
   if (v.observer || (net.info && !net.info->has_player))
-    row("Player", "observing");
+    row(live, "Player", "observing");
   else
-    row("Player", "yours is the white sphere with the amber ring");
+    row(live, "Player", "yours is the white sphere with the amber ring");
+  if (!live) ImGui::TextColored(kWarn, "%s", fresh.note.c_str());
   ImGui::TextColored(kDim, "H: help");
   if (!net.notice.empty() && v.now - net.notice_time < kNoticeSeconds) {
     ImGui::PushTextWrapPos(520.0f);

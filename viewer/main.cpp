@@ -1,11 +1,13 @@
 // fishtank-viewer: flags, then the viewer's loop (viewer/app.cpp). Nothing else.
 
 #include <boost/program_options.hpp>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <string>
 
 #include "viewer/app.h"
+#include "viewer/frame_pacer.h"
 
 namespace po = boost::program_options;
 
@@ -25,8 +27,13 @@ int main(int argc, char** argv) {
       ("outline", po::bool_switch(&opt.tank_outline), "start with the tank's edges shown (T toggles)")  //
       ("screenshot", po::value(&opt.screenshot),
        "render --frames frames after the first snapshot, save the last "
-       "as this PNG file and exit")  //
-      ("frames", po::value(&opt.frames), "frames to render before --screenshot (default 1)");
+       "as this PNG file and exit")                                                           //
+      ("frames", po::value(&opt.frames), "frames to render before --screenshot (default 1)")  //
+      ("max-fps", po::value(&opt.max_fps),
+       "frames per second at most, 0 for no cap (default 60; 30 on a software renderer such as "
+       "Mesa's llvmpipe, which shares the CPU with the server)")  //
+      ("duration", po::value(&opt.duration),
+       "close the viewer after this many seconds (default 0: stay open)");
   po::variables_map vm;
   try {
     po::store(po::parse_command_line(argc, argv, flags), vm);
@@ -51,6 +58,17 @@ int main(int argc, char** argv) {
   opt.port = connect.substr(colon + 1);
   if (opt.frames < 1) {
     std::fprintf(stderr, "fishtank-viewer: --frames must be at least 1\n");
+    return 2;
+  }
+  if (vm.count("max-fps") && (opt.max_fps < 0 || opt.max_fps > fishtank::viewer::FramePacer::kMaxFps)) {
+    std::fprintf(stderr, "fishtank-viewer: --max-fps must be between 0 (no cap) and %d, got %d\n",
+                 fishtank::viewer::FramePacer::kMaxFps, opt.max_fps);
+    return 2;
+  }
+  if (!std::isfinite(opt.duration) || opt.duration < 0.0 || opt.duration > 1e9) {
+    std::fprintf(stderr,
+                 "fishtank-viewer: --duration must be a number of seconds >= 0 (0: stay open), got %g\n",
+                 opt.duration);
     return 2;
   }
   return fishtank::viewer::run_viewer(opt);

@@ -231,6 +231,8 @@ void NetClient::on_snapshot(const wire::Snapshot& s) {
   snap->received = steady_seconds();
   snap->steps_per_s = s.steps_per_s();
   snap->load = s.load();
+  snap->threads_stepping = s.threads_stepping();
+  snap->time_scale = s.time_scale();
   snap->ball_count = s.ball_count();
   if (s.positions()) snap->quantised.assign(s.positions()->begin(), s.positions()->end());  // length checked
   snap->kinds = kinds_;

@@ -17,7 +17,7 @@ namespace fishtank::viewer {
 struct ServerInfo {
   std::string variant;  // "sse" or "scalar"
   std::string simd;     // e.g. "sse4.1"
-  int threads = 0;
+  int threads = 0;      // worker threads at most; Snapshot::threads_stepping says how many step now
   TankBounds tank;
   float dt = 0.0f;
   std::vector<BallKind> kinds;  // indexed by a ball's kind number
@@ -37,6 +37,8 @@ struct Snapshot {
   double received = 0.0;  // local steady-clock seconds, when it arrived
   float steps_per_s = 0.0f;
   float load = 0.0f;
+  std::uint32_t threads_stepping = 0;  // 0: the server did not say
+  float time_scale = 0.0f;             // simulated seconds per wall second; 0: the server did not say
   std::uint32_t ball_count = 0;
   // x, y, z per ball in id order, each 0..65535 over the tank bounds.
   std::vector<std::uint16_t> quantised;

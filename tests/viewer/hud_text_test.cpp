@@ -1,0 +1,46 @@
+// The HUD tells the truth: figures left over from a lost connection are marked
+// as such with their age, and the threads and time scale are the server's.
+
+#include "viewer/hud_text.h"
+
+#include <catch2/catch.hpp>
+
+using namespace fishtank::viewer;
+
+TEST_CASE("while connected the server's figures are live") {
+  const Freshness f = figures_freshness(true, 100.0, 99.98);
+  CHECK(f.live);
+  CHECK(f.note.empty());
+  CHECK(figures_freshness(true, 100.0, -1.0).live);  // welcomed, first snapshot still on its way
+}
+
+TEST_CASE("after a disconnect the figures are greyed and their age counts up in whole seconds") {
+  const double last = 1000.25;
+  CHECK_FALSE(figures_freshness(false, last + 0.1, last).live);
+  CHECK(figures_freshness(false, last + 0.1, last).note == "disconnected, last update 0 s ago");
+  CHECK(figures_freshness(false, last + 1.0, last).note == "disconnected, last update 1 s ago");
+  CHECK(figures_freshness(false, last + 7.9, last).note == "disconnected, last update 7 s ago");
+  CHECK(figures_freshness(false, last + 125.0, last).note == "disconnected, last update 125 s ago");
+}
+
+TEST_CASE("never connected: nothing is live and nothing claims an update") {
+  const Freshness f = figures_freshness(false, 5.0, -1.0);
+  CHECK_FALSE(f.live);
+  CHECK(f.note == "not connected, no update yet");
+}
+
+TEST_CASE("the threads line says how many step out of how many the server has") {
+  CHECK(threads_text(1, 2) == "stepping on 1 of 2 threads");
+  CHECK(threads_text(2, 2) == "stepping on 2 of 2 threads");
+  CHECK(threads_text(1, 1) == "stepping on 1 of 1 thread");
+  CHECK(threads_text(0, 4) == "4 threads at most");  // a server that does not say
+}
+
+TEST_CASE("the time scale reads real time at 1, slow motion with its factor below, nothing when unknown") {
+  CHECK(time_scale_text(1.0f) == "real time");
+  CHECK(time_scale_text(0.99f) == "real time");  // pacing jitter, not slow motion
+  CHECK(time_scale_text(1.02f) == "real time");
+  CHECK(time_scale_text(0.42f) == "slow motion \u00d70.42");
+  CHECK(time_scale_text(0.05f) == "slow motion \u00d70.05");
+  CHECK(time_scale_text(0.0f) == "-");
+}
