@@ -1,5 +1,7 @@
 #include "server/net/client_protocol.h"
 
+#include <cstdio>
+
 namespace fishtank::net {
 
 Outcome ClientProtocol::refuse(wire::ErrorCode code, const std::string& why, bool disconnect) {
@@ -32,8 +34,24 @@ Outcome ClientProtocol::on_frame(const std::uint8_t* frame, std::size_t size) {
   return on_message(*decoded.message);
 }
 
+std::string printable_name(const std::string& raw) {
+  std::string name;
+  for (std::size_t i = 0; i < raw.size() && i < kMaxNameBytes; ++i) {
+    const auto c = static_cast<unsigned char>(raw[i]);
+    if (c >= 0x20 && c < 0x7f && c != '\\') {
+      name += static_cast<char>(c);
+    } else {
+      char escaped[5];
+      std::snprintf(escaped, sizeof escaped, "\\x%02x", c);
+      name += escaped;
+    }
+  }
+  if (raw.size() > kMaxNameBytes) name += "...";
+  return name;
+}
+
 Outcome ClientProtocol::on_hello(const wire::Hello& hello) {
-  if (hello.client_name()) name_ = hello.client_name()->str();
+  if (hello.client_name()) name_ = printable_name(hello.client_name()->str());
   if (hello.protocol_version() != protocol::kProtocolVersion)
     return refuse(wire::ErrorCode::version_mismatch,
                   "this server speaks protocol version " + std::to_string(protocol::kProtocolVersion) +

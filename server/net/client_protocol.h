@@ -33,6 +33,11 @@ struct Outcome {
   std::string log;                       // worth a line in the server log when not empty
 };
 
+// A peer's name as it may be written to the log: control and non-ASCII bytes
+// as \xNN, so that a name cannot forge a line, cut to kMaxNameBytes.
+std::string printable_name(const std::string& raw);
+inline constexpr std::size_t kMaxNameBytes = 64;
+
 class ClientProtocol {
  public:
   ClientProtocol(std::uint32_t client_id, const ServerInfo& info) : client_id_(client_id), info_(info) {}

@@ -123,8 +123,9 @@ bool World::remove_player(std::uint32_t id) {
 bool World::set_player_velocity(std::uint32_t id, Vec3 v) {
   auto it = std::find(player_ids_.begin(), player_ids_.end(), id);
   if (it == player_ids_.end() || !is_finite(v)) return false;
-  float speed = length(v);
-  if (speed > params_.player_max_speed) v = v * (params_.player_max_speed / speed);
+  // In double: a finite float velocity's squared length can overflow a float.
+  const double speed = std::sqrt(double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z);
+  if (speed > params_.player_max_speed) v = v * static_cast<float>(params_.player_max_speed / speed);
   player_vel_[it - player_ids_.begin()] = {v.x, v.y, v.z, 0.0f};
   return true;
 }

@@ -76,3 +76,17 @@ TEST_CASE("balls added to a full, settled tank wait at the top instead of being 
   CHECK(world.escaped_or_invalid() == 0);
   CHECK(world.max_overlap_fraction() < 0.15f);
 }
+
+TEST_CASE("a player velocity too large to square in a float is clamped to the top speed, not stopped",
+          "[physics][extreme]") {
+  World world(PhysicsParams{}, kScalarKernels, 1, 1);
+  const std::uint32_t id = world.add_player();
+  const Vec3 start = world.player_position(id);
+  REQUIRE(world.set_player_velocity(id, {3e38f, 0.0f, 0.0f}));  // |v|^2 overflows a float
+  for (int s = 0; s < 100; ++s) world.step();
+  const Vec3 moved = world.player_position(id) - start;
+  const float expected = world.params().player_max_speed * 100 * world.dt();
+  CHECK(moved.x == Approx(expected).epsilon(1e-3));
+  CHECK(moved.y == 0.0f);
+  CHECK(moved.z == 0.0f);
+}
