@@ -26,8 +26,8 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       threaded ? "worker threads at most (default: the cores available now); the server steps on one "
                  "instead while that measures faster (a busy machine)"
                : "worker threads (the scalar build uses 1)")("fixed-threads", po::bool_switch(&o.fixed_threads),
-                                                             "always step on every --threads thread")("seed", po::value(&seed)->default_value(seed),
-                                                             "random seed for spawning, >= 0")(
+                                                             "always step on every --threads thread")(
+      "seed", po::value(&seed)->default_value(seed), "random seed for spawning, >= 0")(
       "balls", po::value(&balls), "balls to pour in at start (default 1000; with --bench, 6000)")(
       "max-balls", po::value(&max_balls)->default_value(0), "most balls the tank may hold (0: its capacity, ~6100)")(
       "duration", po::value(&o.duration)->default_value(0.0), "stop after this many seconds (0: run until Ctrl-C)")(

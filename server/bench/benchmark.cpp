@@ -59,7 +59,8 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   j["threads"] = world.threads();
   j["thread_shares"] = world.thread_shares();  // of the items the timed steps' passes computed
   // The thread tuner's choice: the fraction of the timed steps taken on one thread.
-  j["one_thread_step_fraction"] = double(world.steps_on_one_thread() - one_thread_before) / std::max<std::uint64_t>(1, spec.steps);
+  j["one_thread_step_fraction"] =
+      double(world.steps_on_one_thread() - one_thread_before) / std::max<std::uint64_t>(1, spec.steps);
   j["balls"] = world.ball_count();
   j["steps"] = spec.steps;
   j["seconds"] = seconds;

@@ -32,9 +32,9 @@ int ThreadTuner::record(double busy_seconds, std::uint64_t steps, double now) {
   if (one_.measured && all_.measured && estimate(other()).cost < (1.0 - margin) * estimate(chosen_).cost)
     chosen_ = other();
   threads_ = chosen_;
-  const double backoff =
-      estimate(other()).measured ? std::clamp(estimate(other()).cost / estimate(chosen_).cost, 1.0, kMaxProbeBackoff)
-                                 : 1.0;
+  const double backoff = estimate(other()).measured
+                             ? std::clamp(estimate(other()).cost / estimate(chosen_).cost, 1.0, kMaxProbeBackoff)
+                             : 1.0;
   if (now - last_probe_ >= kProbeSeconds * backoff) {
     threads_ = other();
     last_probe_ = now;

@@ -235,9 +235,9 @@ class World {
     Moved moved;
   };
   std::vector<ChunkMoved> chunk_moved_;
-  std::vector<char> chunk_missing_;       // per chunk: a far ball misses a contact
-  std::vector<std::uint32_t> far_balls_;  // per chunk, from its begin: its far balls
-  bool far_listed_ = false;               // whether the last pass listed them
+  std::vector<char> chunk_missing_;           // per chunk: a far ball misses a contact
+  std::vector<std::uint32_t> far_balls_;      // per chunk, from its begin: its far balls
+  bool far_listed_ = false;                   // whether the last pass listed them
   std::vector<std::uint32_t> chunk_longest_;  // per chunk: the longest list it built
   std::vector<std::uint32_t> order_;
   std::vector<NewBall> placed_;

@@ -121,7 +121,8 @@ TEST_CASE("a worker that picks up a phase late never runs a later phase's chunk"
       for (std::uint32_t i = begin; i < end; ++i) seen[i].fetch_add(1);
       busy_until(Clock::now() + std::chrono::nanoseconds(50) * (end - begin));
     });
-    all_once = all_once && std::all_of(seen.get(), seen.get() + kItems, [](const std::atomic<int>& s) { return s == 1; });
+    all_once =
+        all_once && std::all_of(seen.get(), seen.get() + kItems, [](const std::atomic<int>& s) { return s == 1; });
   }
   CHECK(all_once);
   CHECK(picked_up >= 40);

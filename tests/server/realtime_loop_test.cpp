@@ -47,14 +47,14 @@ PhysicsParams with_stiffness(float stiffness) {
 // `balls` in a lattice, at rest.
 void place_lattice(World& world, int balls) {
   for (int b = 0; b < balls; ++b)
-    world.place_ball(b % kKindCount, {-18.5f + 3.1f * (b % 12), 1.6f + 3.1f * (b / 144), -18.5f + 3.1f * ((b / 12) % 12)},
+    world.place_ball(b % kKindCount,
+                     {-18.5f + 3.1f * (b % 12), 1.6f + 3.1f * (b / 144), -18.5f + 3.1f * ((b / 12) % 12)},
                      {0.0f, 0.0f, 0.0f});
 }
 
 }  // namespace
 
-TEST_CASE("a world far over its real-time budget runs in slow motion, and the loop keeps its rate",
-          "[server][loop]") {
+TEST_CASE("a world far over its real-time budget runs in slow motion, and the loop keeps its rate", "[server][loop]") {
   // Stiff contacts make dt tiny: real time would need far more steps per second than one thread runs.
   World world(with_stiffness(1e9f), kSseKernels, 1, 5);
   place_lattice(world, 1500);
