@@ -60,7 +60,7 @@ std::uint64_t read_all(const wire::Message& m) {
     for (std::uint8_t kind : *k->kinds()) sum += kind;
   } else if (const auto* w = m.payload_as_Welcome()) {
     for (const wire::BallKindInfo* kind : *w->ball_kinds()) sum += kind->r();
-    sum += w->server_variant()->size() + w->simd_level()->size() + static_cast<std::uint64_t>(w->tank_min()->x());
+    sum += w->server_variant()->size() + w->simd_level()->size() + (w->tank_min()->x() < 0.0f);
   } else if (const auto* e = m.payload_as_Error()) {
     sum += e->message()->size();
   }
