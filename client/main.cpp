@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
                         {"time_scale", s.time_scale},
                         {"at_rest_fraction", s.at_rest_fraction},
                         {"int8_delta_fraction", s.int8_delta_fraction},
+                        {"dropped", s.dropped},
                         {"errors", s.error_messages.size()},
                         {"error_messages", s.error_messages}};
     std::cout << j.dump() << std::endl;
@@ -44,6 +45,10 @@ int main(int argc, char** argv) {
               << std::lround(100.0 * s.load) << " % on " << s.threads_stepping << " of " << s.worker_threads
               << " threads, time scale " << s.time_scale << "\n";
     for (const std::string& e : s.error_messages) std::cout << "error: " << e << "\n";
+  }
+  if (s.dropped > 0) {
+    std::cerr << "fishtank-client: the server dropped " << s.dropped << " of " << s.clients << " connections\n";
+    return 1;
   }
   return 0;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <boost/asio.hpp>
 #include <chrono>
+#include <cmath>
 #include <functional>
 #include <memory>
 
@@ -86,12 +87,16 @@ Summary run_script(const Script& script) {
   std::vector<int> move_phase(connections.size(), 0);
   int tick = 0;
   asio::steady_timer timer(io);
+  std::vector<double> dropped_at(connections.size(), -1.0);  // seconds; -1 while open
   std::function<void()> on_tick = [&] {
     const double t = seconds_since(start);
     if (t >= script.duration) {
       for (auto& c : connections) c->close();
       return;
     }
+    for (std::size_t i = 0; i < connections.size(); ++i)
+      if (dropped_at[i] < 0.0 && connections[i]->closed()) dropped_at[i] = t;
+    if (std::all_of(dropped_at.begin(), dropped_at.end(), [](double d) { return d >= 0.0; })) return;  // all gone
     if (!added && script.add > 0 && connections.front()->welcomed()) {
       connections.front()->send(protocol::encode_add_balls(script.add));
       added = true;
@@ -117,7 +122,14 @@ Summary run_script(const Script& script) {
   on_tick();
   io.run();
 
-  Summary summary = summarise(connections, std::max(script.duration, 1e-3));
+  // Rates over the time the script ran: a dropped connection's snapshots do not read as a live rate.
+  Summary summary = summarise(connections, std::max(std::min(script.duration, seconds_since(start)), 1e-3));
+  for (std::size_t i = 0; i < connections.size(); ++i) {
+    if (dropped_at[i] < 0.0 || !connections[i]->welcomed()) continue;
+    ++summary.dropped;
+    summary.error_messages.push_back("dropped by the server after " + std::to_string(std::lround(dropped_at[i])) +
+                                     " s: " + connections[i]->close_reason());
+  }
   if (summary.welcomed == 0 && !connections.empty()) summary.connect_error = connections.front()->close_reason();
   return summary;
 }

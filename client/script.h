@@ -42,6 +42,9 @@ struct Summary {
   double int8_delta_fraction = 0.0;  // likewise (ConnectionStats::int8_delta_fraction)
   std::vector<std::string> error_messages;
   std::string connect_error;  // non-empty when no connection could be made
+  // Connections the server closed before --duration was up (each also has an
+  // error message saying why); the script ends early once all are closed.
+  int dropped = 0;
 };
 
 Summary run_script(const Script& script);

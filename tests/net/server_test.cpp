@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "client/connection.h"
+#include "client/script.h"
 #include "protocol/frame_codec.h"
 #include "server_process.h"
 
@@ -393,4 +394,24 @@ TEST_CASE("physics far over its real-time budget: observers keep their snapshot 
   CHECK(scale > 0.0f);
   CHECK(scale < 0.9f);
   CHECK(server.running());
+}
+
+TEST_CASE("a client the server drops says so and stops, instead of waiting out its duration", "[net]") {
+  ServerProcess server({"--balls", "100"});
+  client::Script script;
+  script.port = server.port();
+  script.observer = true;
+  script.duration = 20.0;
+  client::Summary summary;
+  const auto start = std::chrono::steady_clock::now();
+  std::thread run([&] { summary = client::run_script(script); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  server.terminate();
+  run.join();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  CHECK(summary.welcomed == 1);
+  CHECK(summary.dropped == 1);
+  CHECK(seconds < 10.0);  // not the 20 s asked
+  REQUIRE_FALSE(summary.error_messages.empty());
+  CHECK(summary.error_messages.back().find("dropped by the server") != std::string::npos);
 }
