@@ -57,7 +57,7 @@ Frame encode_ping(std::uint32_t client_time_us);
 // ---- encoding: server -> client ----
 struct WelcomeInfo {
   std::uint32_t client_id = 0;
-  std::string server_variant;  // "sse" or "scalar"
+  std::string server_variant;  // the kernel set: "scalar", "sse" or "avx2"
   std::string simd_level;
   std::uint32_t worker_threads = 1;
   TankBounds tank;

@@ -1,5 +1,5 @@
-// fishtank-server: flags and wiring only. The variant (scalar or SSE) is fixed
-// at compile time by FISHTANK_SIMD; both executables come from this file.
+// fishtank-server: flags and wiring only. The kernel set (scalar, SSE or AVX2)
+// is fixed at compile time by FISHTANK_SIMD; all three executables come from this file.
 
 #include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>

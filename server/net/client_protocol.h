@@ -18,7 +18,7 @@ namespace fishtank::net {
 
 // What every Welcome says about this server.
 struct ServerInfo {
-  std::string variant;  // "sse" or "scalar"
+  std::string variant;  // the kernel set: "scalar", "sse" or "avx2"
   std::string simd;
   std::uint32_t worker_threads = 1;
   TankBounds tank;
