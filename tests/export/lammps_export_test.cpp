@@ -108,7 +108,7 @@ TEST_CASE("the exported script has every pair coefficient and wall with the serv
 
 TEST_CASE("LAMMPS runs the exported scene without losing a ball", "[export][lammps]") {
   if (std::system("command -v lmp >/dev/null 2>&1") != 0) {
-    WARN("lmp is not installed (Debian package lammps); skipping the LAMMPS run");
+    WARN("SKIPPED: lmp is not installed (Debian package lammps: scripts/install-deps lammps)");
     return;
   }
   World world(PhysicsParams{}, kSseKernels, 1, 2);

@@ -80,7 +80,7 @@ TEST_CASE("a stalled worker holds up no step and changes nothing", "[physics][de
 
 TEST_CASE("the AVX2 level's state is bit-identical for 1, 2 and 3 threads", "[physics][determinism]") {
   if (!cpu_has_avx2()) {
-    WARN("this processor has no AVX2; nothing to compare");
+    WARN("SKIPPED: this processor has no AVX2; nothing to compare");
     return;
   }
   // The AVX2 kernel carries eight balls per vector and sums with fused

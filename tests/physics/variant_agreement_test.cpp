@@ -88,7 +88,7 @@ TEST_CASE("scalar and SSE settle into the same pile", "[physics][variants][slow]
 
 TEST_CASE("scalar and AVX2 trajectories agree over a short horizon", "[physics][variants]") {
   if (!cpu_has_avx2()) {
-    WARN("this processor has no AVX2; nothing to compare");
+    WARN("SKIPPED: this processor has no AVX2; nothing to compare");
     return;
   }
   // Fused multiply-adds round differently from separate ones, so the AVX2
