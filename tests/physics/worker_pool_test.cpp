@@ -129,7 +129,7 @@ TEST_CASE("a worker that picks up a phase late never runs a later phase's chunk"
 }
 
 TEST_CASE("a thread three times slower computes about a quarter of the items", "[pool]") {
-  // Thread 1 takes 15 us per item, thread 0 5 us: in equal time, 1 : 3.
+  // The test makes thread 1 three times slower per item than thread 0: in equal time, 1 : 3.
   constexpr std::uint32_t kItems = 4096;
   WorkerPool pool(2, 64);
   const std::thread::id caller = std::this_thread::get_id();
