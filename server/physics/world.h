@@ -111,7 +111,6 @@ class World {
   int threads() const { return pool_.threads(); }
   // Steps use at most this many of the threads (results do not depend on it).
   void set_thread_limit(int limit) { pool_.set_active_limit(limit); }
-  int thread_limit() const { return pool_.active_limit(); }
   // Lets each step choose between every thread and one by measurement, as the
   // machine's load changes (ThreadTuner); off by default.
   void set_thread_tuning(bool on);
