@@ -106,14 +106,11 @@ struct BatchReach {
   }
 };
 
-// The rows a batch's lists name far from the batch in the sorted order: in
-// practice the neighbours across a column block's x faces (sort() above), a
-// whole block of balls away, where neither the rows that the SIMD step asks
-// for ahead nor those it read lately lie (kernels_simd_ball.h, is_far_row).
-// One row per cache line of rows, up to kMost: a batch that names more keeps
-// the first kMost, and the rest are only asked for late, never wrong. The
-// SIMD builds write them and the SIMD steps ask for them ahead.
-struct FarRows {
+// The rows a batch's lists name far from it in memory: in practice the
+// neighbours across a column block's x faces (sort() above), out of reach of
+// the SIMD step's prefetch ahead (kernels_simd_ball.h, is_remote_row). One row
+// per cache line, up to kMost; past that a row is only fetched late.
+struct RemoteRows {
   static constexpr std::uint32_t kMost = 31;
   static constexpr std::uint32_t kRowsPerLine = 64 / sizeof(Float4);
   std::uint32_t count = 0;
@@ -152,7 +149,7 @@ struct ListBuild {
   BatchReach* reach;             // out, threaded builds only: per batch, the balls its stored lists name
   std::uint32_t* group_records;  // out, SIMD builds only: per group, its record (see above)
   std::uint32_t* group_blocks;   // out, SIMD builds only: per group, its number of blocks
-  FarRows* far_rows;             // out, SIMD builds only, unless null: per batch, its far rows
+  RemoteRows* remote_rows;       // out, SIMD builds only, unless null: per batch, its remote rows
 };
 
 // One ball's stored list: neighbour k is listed_index(first[k * lanes]).
@@ -161,6 +158,16 @@ struct ListView {
   std::uint32_t count;
   std::uint32_t lanes;
   std::uint32_t operator[](std::uint32_t k) const { return listed_index(first[std::size_t(k) * lanes]); }
+};
+
+// The lists of the last build as a step reads them (the layout above): with
+// one lane, `counts` says where a list ends; with more, each group's record and blocks.
+struct StepLists {
+  const std::uint32_t* neighbours = nullptr;
+  std::uint32_t stride = 0;
+  const std::uint32_t* counts = nullptr;         // one lane
+  const std::uint32_t* group_records = nullptr;  // more lanes
+  const std::uint32_t* group_blocks = nullptr;   // more lanes
 };
 
 // Ghost slots after the last ball: a SIMD build reads up to three balls past
@@ -274,7 +281,13 @@ class NeighbourList {
   const BatchReach* batch_reach() const { return reach_.data(); }
   const std::uint32_t* group_records() const { return group_records_.data(); }
   const std::uint32_t* group_blocks() const { return group_blocks_.data(); }
-  const FarRows* far_rows() const { return far_rows_.data(); }
+  StepLists step_lists() const {
+    StepLists l;
+    l.neighbours = neighbours(), l.stride = stride_, l.counts = counts();
+    l.group_records = group_records(), l.group_blocks = group_blocks();
+    return l;
+  }
+  const RemoteRows* remote_rows() const { return remote_rows_.data(); }
 
   // Calls visit(i, ListView) once for each ball of the last build, batch by
   // batch in the layout's order.
@@ -313,7 +326,7 @@ class NeighbourList {
   std::vector<BatchReach> reach_;
   AlignedVector<std::uint32_t> group_records_;  // SIMD builds only
   std::vector<std::uint32_t> group_blocks_;     // SIMD builds only
-  std::vector<FarRows> far_rows_;               // SIMD builds only
+  std::vector<RemoteRows> remote_rows_;         // SIMD builds only
   AlignedVector<float> axes_;                   // x, y, z, radius of the sorted balls, axis by axis (ListBuild)
 };
 

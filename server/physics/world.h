@@ -44,10 +44,10 @@ struct PhaseSeconds {
   double neighbours = 0.0;  // sort, reorder and list build, and checks that keep the lists
   double step_pass = 0.0;   // forces and integration
   // Parts of neighbours: the balls sorted by cell and their arrays reordered,
-  // the lists built, and the far balls checked (World::lists_hold).
+  // the lists built, and the strayed balls checked (World::lists_hold).
   double sort = 0.0;
   double list_build = 0.0;
-  double far_checks = 0.0;
+  double stray_checks = 0.0;
 };
 
 struct AddResult {
@@ -99,9 +99,9 @@ class World {
   std::uint64_t rebuilds() const { return rebuilds_; }
   // Steps whose lists were kept after checking the balls that had moved more
   // than skin / 2 since the build (lists_hold()).
-  std::uint64_t lists_kept_far() const { return lists_kept_far_; }
+  std::uint64_t lists_kept_by_checks() const { return lists_kept_by_checks_; }
   // Balls checked in those steps and in the steps whose checks found a contact.
-  std::uint64_t far_balls_checked() const { return far_checked_; }
+  std::uint64_t strayed_balls_checked() const { return strayed_checked_; }
   // The lists of the last build, for tests and tools.
   const NeighbourList& neighbour_list() const { return list_; }
   float dt() const { return model_.dt; }
@@ -175,7 +175,8 @@ class World {
   static constexpr std::uint32_t kBeyondCacheBalls = 32768;
   void derive_velocities() const;
   void advance();  // one step, untimed
-  void add_edge_fetches(StepArrays& s, std::uint32_t begin, std::uint32_t end) const;
+  PrefetchPlan prefetch_plan() const;
+  void add_edge_fetches(PrefetchPlan& plan, std::uint32_t begin, std::uint32_t end) const;
 
   PhysicsParams params_;
   ContactModel model_;
@@ -222,21 +223,21 @@ class World {
   // lists lack a few steps later, with half again the checks per step
   // (measured in a build without this bound: 669-738 us of checks per step
   // against 474-505, the same 40 rebuilds per 1000 steps).
-  static constexpr std::uint32_t kFarBallsPerCheck = 256;
+  static constexpr std::uint32_t kStrayedBallsPerCheck = 256;
   // Far balls' checks per thread at least: a check costs a few dozen balls'
   // steps, so from 8 checks two threads share them (measured within
   // this machine's noise: +1.4, -1.5 and +1.5 % of a settled tank's step).
-  static constexpr std::uint32_t kFarChecksPerThread = 4;
-  static constexpr float kFarMargin = 1.0f - 1e-5f;  // a ball right at skin / 2 counts as far
+  static constexpr std::uint32_t kStrayChecksPerThread = 4;
+  static constexpr float kStrayMargin = 1.0f - 1e-5f;  // a ball right at skin / 2 counts as strayed
   // What each chunk of the last step pass reported.
   struct ChunkMoved {
     std::uint32_t begin = 0;
     Moved moved;
   };
   std::vector<ChunkMoved> chunk_moved_;
-  std::vector<char> chunk_missing_;           // per chunk: a far ball misses a contact
-  std::vector<std::uint32_t> far_balls_;      // per chunk, from its begin: its far balls
-  bool far_listed_ = false;                   // whether the last pass listed them
+  std::vector<char> chunk_missing_;           // per chunk: a strayed ball misses a contact
+  std::vector<std::uint32_t> stray_balls_;    // per chunk, from its begin: its strayed balls
+  bool strayed_listed_ = false;               // whether the last pass listed them
   std::vector<std::uint32_t> chunk_longest_;  // per chunk: the longest list it built
   std::vector<std::uint32_t> order_;
   std::vector<NewBall> placed_;
@@ -245,9 +246,9 @@ class World {
   std::uint64_t steps_ = 0;
   std::uint64_t one_thread_steps_ = 0;
   std::uint64_t rebuilds_ = 0;
-  std::uint64_t lists_kept_far_ = 0;
-  std::uint64_t far_checked_ = 0;
-  std::uint64_t built_at_step_ = 0, far_checked_at_build_ = 0;  // steps_ and far_checked_ at the last build
+  std::uint64_t lists_kept_by_checks_ = 0;
+  std::uint64_t strayed_checked_ = 0;
+  std::uint64_t built_at_step_ = 0, strayed_checked_at_build_ = 0;  // at the last build
   PhaseSeconds phase_seconds_;
 };
 
