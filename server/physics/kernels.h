@@ -3,21 +3,15 @@
 // twins with the same signatures:
 //   kernels_scalar.cpp  plain C++, one pair at a time (the reference)
 //   kernels_sse.cpp     SSE4.1, four balls and one neighbour of each at a time
-//   kernels_avx2.cpp    AVX2 + FMA, eight balls and one neighbour of each at a time (a third level)
-// The two SIMD files share their passes, written once for either vector
-// type (kernels_simd_ball.h); each says how to gather and scatter its lanes.
-// A build picks one set at compile time (see server/main.cpp); the tests hold
-// them all so they can compare them.
+//   kernels_avx2.cpp    AVX2 + FMA, eight balls at a time (a third level)
+// The SIMD passes are written once for either vector (kernels_simd_ball.h).
 //
-// Velocity Verlet in one pass over the balls per step. Positions and
-// half-step velocities are double-buffered: the pass reads this step's
+// Velocity Verlet in one pass per step, double-buffered: the pass reads
 // (pos, vel_half) of ball i and its neighbours and writes only ball i's
 // outputs, so chunks run in parallel with no races and no atomics:
 //   a    = F(pos, vel_half) / m + g
 //   v    = vel_half + a dt/2                 (the full step, not stored)
 //   vel_half_next = v + a dt/2,  pos_next = pos + vel_half_next dt
-// Observers' full-step velocity is the mean of vel_half and vel_half_next,
-// derived when someone asks (World::velocities).
 
 #include <cstdint>
 #include <limits>
@@ -76,28 +70,19 @@ struct Kernels {
   const char* simd;          // instruction set of the kernels
   bool threaded;             // whether the build may use more than one thread
   std::uint32_t list_lanes;  // balls per group in the lists' layout (broadphase.h)
-  // Each pass takes balls [begin, end), where begin is a multiple of
-  // kStepBatch and end is one too or the last ball's index + 1, as in every
-  // WorkerPool chunk of the world: the lists are laid out per batch.
-  //
-  // The step. Returns how far the balls moved from where the lists were
-  // built, which tells when they must be rebuilt.
+  // Each pass takes balls [begin, end) from batch edges (kStepBatch): the lists are laid out per batch.
+  // The step returns how far the balls moved since the build, which says when to rebuild.
   Moved (*step)(const StepArrays& s, const PrefetchPlan& plan, const ContactModel& m, std::uint32_t begin,
                 std::uint32_t end);
-  // a = F(pos, vel_half) / m + g only, into acc: for a state whose forces are
-  // not known yet (balls placed in contact). Writes none of s's outputs.
+  // a = F(pos, vel_half) / m + g only, into acc: for balls placed in contact, whose forces are not known yet.
   void (*accelerations)(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin,
                         std::uint32_t end);
   // Neighbour lists (see broadphase.h). Returns the longest.
   std::uint32_t (*build_lists)(const ListBuild& b, std::uint32_t begin, std::uint32_t end);
 };
 
-// The second half of a step for one ball, in plain C++: the half kick from
-// the full-step velocity v with acceleration a, then the drift from p into
-// vel_half_next and pos_next (v's w, which must be 1 / mass, goes with it).
-// Returns the squared distance of pos_next from
-// at_build. The scalar step kernel uses it, and so does the world for balls
-// whose acceleration it computes itself (spawned, or placed in contact).
+// One ball's half kick from full-step velocity v (w: 1 / mass) and drift from p; returns the squared
+// distance of pos_next from at_build. The scalar step and the world's spawned or placed balls share it.
 inline float kick_drift(const ContactModel& m, const Float4& v, const Float4& p, const Float4& a,
                         const Float4& at_build, Float4& vel_half_next, Float4& pos_next) {
   const Float4 vh{v.x + a.x * m.half_dt, v.y + a.y * m.half_dt, v.z + a.z * m.half_dt, v.w};

@@ -93,10 +93,8 @@ inline std::uint8_t length_contacts_key(std::uint32_t touching, std::uint32_t li
   return std::uint8_t(std::min(listed, 15u) * 16 + std::min(touching, 15u));
 }
 
-// Balls first..end-1 of a batch by their length_contacts_key (a counting sort;
-// keys[b - first] is ball b's), padded to a multiple of `lanes` with the
-// last one repeated: a repeated ball is computed twice and stored twice,
-// with the same result. Returns the length.
+// Balls first..end-1 by their keys (keys[b - first], a counting sort), padded to a multiple of
+// `lanes` by repeating the last: it is computed and stored twice, with the same result.
 inline std::uint32_t by_length_and_contacts(const std::uint8_t* keys, std::uint32_t first, std::uint32_t end,
                                             std::uint32_t lanes, std::uint32_t* order) {
   constexpr std::uint32_t kBuckets = 256;
@@ -185,9 +183,8 @@ std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t
   return longest;
 }
 
-// Lanes<V> (each kernel file): kCount lanes; load gathers the rows that list
-// entries at[0..] name into lanes, store scatters them back, largest(a) is
-// the largest lane.
+// Lanes<V> (each kernel file): kCount lanes; load gathers the rows list entries at[0..] name into
+// lanes, store scatters them back, largest(a) is the largest lane.
 template <class V>
 struct Lanes;
 
@@ -287,9 +284,8 @@ constexpr std::size_t kCacheLine = 64;
 // latter are asked for non-temporally, so they do not evict the former.
 enum class Reuse { kAgain, kOnce };
 
-// Asks for the cache line `bytes` past `base`. A prefetch never faults, so
-// the address may lie past an array's end; it is formed as an integer, not
-// by pointer arithmetic.
+// Asks for the cache line `bytes` past `base`. A prefetch never faults, so the address may lie past
+// an array's end: formed as an integer, not by pointer arithmetic.
 template <Reuse kReuse>
 inline void prefetch(const void* base, std::size_t bytes) {
   constexpr int kLocality = kReuse == Reuse::kAgain ? 3 : 0;  // 0: prefetchnta
@@ -343,10 +339,8 @@ template <std::uint32_t kCount>
   }
 }
 
-// A batch's groups (kStepBatch, broadphase.h), one ball per lane: neighbour
-// sums, walls and players give a = F / m + g, and per_group(at, i, ax, ay, az,
-// record) does the rest for the balls at list entries `at`. A padded group
-// repeats a ball: it is computed and stored twice, with the same result.
+// A batch's groups, one ball per lane: a = F / m + g, then per_group(at, i, ax, ay, az, record)
+// does the rest for the balls at list entries `at`.
 template <class V, class PerGroup>
 [[gnu::always_inline]] inline void for_each_group_of_batch(const StepArrays& s, const PrefetchPlan& plan,
                                                            const ContactModel& m, std::uint32_t batch,
