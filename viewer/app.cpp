@@ -175,7 +175,7 @@ int run_viewer(const ViewerOptions& opt) {
       int own = -1;
       instances.clear();
       if (have_frame && status.info) {
-        const TankBounds& tank = status.info->tank;
+        const TankBounds& tank = pair.to->tank;
         if (!same_box(framed, tank)) {
           camera.frame(tank);
           tank_outline.set_bounds(tank);
