@@ -4,6 +4,8 @@
 #include <cmath>
 #include <random>
 
+#include "common/scene_names.h"
+
 namespace fishtank {
 
 namespace {
@@ -54,10 +56,10 @@ std::string too_many(const SceneSpec& spec, std::uint32_t placed) {
 
 const std::vector<ScenePreset>& scene_presets() {
   static const std::vector<ScenePreset> presets{
-      {"tank", "the 40-unit fish tank; balls of three sizes pour in from the top", 1000},
-      {"wide", "a tank widened for its balls, dropped from a loose lattice into a layer", 6000},
-      {"dam-break", "a column of small balls against one wall, released", 3000},
-      {"drop", "large balls fall onto a bed of small ones", 3000},
+      {kSceneNames[0], "the 40-unit fish tank; balls of three sizes pour in from the top", 1000},
+      {kSceneNames[1], "a tank widened for its balls, dropped from a loose lattice into a layer", 6000},
+      {kSceneNames[2], "a column of small balls against one wall, released", 3000},
+      {kSceneNames[3], "large balls fall onto a bed of small ones", 3000},
   };
   return presets;
 }

@@ -56,6 +56,12 @@ void NetClient::add_balls(std::uint32_t count) {
   });
 }
 
+void NetClient::send_command(protocol::Frame frame) {
+  asio::post(io_, [this, frame = std::move(frame)]() mutable {
+    if (connected_) send(std::move(frame));
+  });
+}
+
 ConnectionStatus NetClient::status() const {
   std::lock_guard lock(status_mutex_);
   return status_;
@@ -217,7 +223,8 @@ void NetClient::on_ball_kinds(const wire::BallKinds& k) {
   // Earlier than the kinds known: a scene started again and ids restart; later: a gap.
   if (k.first_new_ball() > kinds_->size()) return lose("the server skipped ball kinds");
   // Copy on write: snapshots already handed to the render thread keep the old list.
-  auto kinds = std::make_shared<std::vector<std::uint8_t>>(kinds_->begin(), kinds_->begin() + k.first_new_ball());
+  auto kinds =
+      std::make_shared<std::vector<std::uint8_t>>(kinds_->begin(), kinds_->begin() + k.first_new_ball());
   for (std::uint8_t kind : *k.kinds()) {
     if (kind >= info_->kinds.size())
       return lose("the server sent ball kind " + std::to_string(kind) + ", unknown");
@@ -250,7 +257,8 @@ void NetClient::on_snapshot(const wire::Snapshot& s) {
     for (flatbuffers::uoffset_t i = 0; i < s.player_ids()->size(); ++i)
       snap->players.push_back({s.player_ids()->Get(i), to_vec3(*s.player_positions()->Get(i))});
   // Other balls under the same ids: nothing to blend with the old scene's.
-  if (const auto last = snapshots_.newest(); last && last->scene_start != snap->scene_start) snapshots_.clear();
+  if (const auto last = snapshots_.newest(); last && last->scene_start != snap->scene_start)
+    snapshots_.clear();
   snapshots_.push(std::move(snap));
   ++snapshots_this_second_;
 }
