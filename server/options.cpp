@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "common/scene_names.h"
 #include "server/physics/worker_pool.h"
 #include "server/scenes/scene_presets.h"
 
@@ -13,7 +14,7 @@ namespace po = boost::program_options;
 
 namespace {
 std::string scene_help() {
-  return "scene to start with, which clients may switch live (also --bench's): " + scene_names();
+  return "scene to start with, which clients may switch live (also --bench's): " + scene_names_text();
 }
 }  // namespace
 
@@ -109,8 +110,8 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
     result.message = "fishtank-server: " + why;
     return result;
   };
-  if (!is_known_scene(o.bench_spec.scene.name))
-    return fail("unknown scene '" + o.bench_spec.scene.name + "'; the scenes are " + scene_names());
+  if (!is_scene_name(o.bench_spec.scene.name))
+    return fail("unknown scene '" + o.bench_spec.scene.name + "'; the scenes are " + scene_names_text());
   o.balls_given = balls != -1;
   if (balls == -1) balls = o.bench ? 6000 : default_balls(o.bench_spec.scene.name);
   if (balls < 0 || balls > 10'000'000)

@@ -2,7 +2,7 @@
 
 #include <cstdio>
 
-#include "server/scenes/scene_presets.h"
+#include "common/scene_names.h"
 
 namespace fishtank::net {
 
@@ -111,9 +111,9 @@ Outcome ClientProtocol::on_control(const wire::Message& message) {
       ResetCommand reset;
       if (r.scene()) {
         reset.scene = r.scene()->str();
-        if (!is_known_scene(*reset.scene))
+        if (!is_scene_name(*reset.scene))
           return refuse(wire::ErrorCode::invalid_value,
-                        "unknown scene '" + printable_name(*reset.scene) + "'; the scenes are " + scene_names(),
+                        "unknown scene '" + printable_name(*reset.scene) + "'; the scenes are " + scene_names_text(),
                         /*disconnect=*/false);
       }
       if (r.seed()) reset.seed = *r.seed();

@@ -13,7 +13,6 @@
 
 #include <cstdint>
 #include <string>
-#include <vector>
 
 #include "server/physics/world.h"
 
@@ -26,19 +25,9 @@ struct SceneSpec {
   double max_settle_seconds = 0.0;  // simulated; 0 means the scene's default (the benchmark's settle())
 };
 
-struct ScenePreset {
-  const char* name;
-  const char* summary;          // one line, for --help and the manual
-  std::uint32_t default_balls;  // interactive start when --balls is not given
-};
-
-// In the order the viewer's number keys select them (1 = tank).
-const std::vector<ScenePreset>& scene_presets();
-bool is_known_scene(const std::string& name);
-// The preset's default_balls; 0 for an unknown name.
+// Balls of an interactive start when --balls is not given; 0 for an unknown name
+// (common/scene_names.h lists the names).
 std::uint32_t default_balls(const std::string& name);
-// "tank, wide, dam-break and drop", for messages.
-std::string scene_names();
 // Tank bounds the scene needs for this many balls.
 TankBounds scene_tank(const SceneSpec& spec);
 // Puts the scene's balls in (queued or placed); returns a refusal message or "".
