@@ -26,7 +26,13 @@ PhysicsLink::PhysicsLink(CommandQueue& queue, const std::atomic<int>& viewers, P
 
 void PhysicsLink::at_step_boundary(World& world, const LoopStatus& status) {
   queue_.drain(drained_);
-  for (const Command& command : drained_) apply(world, command);
+  // A reset replaces everything before it, so of a burst only the last is
+  // carried out: a client repeating Reset cannot stall the physics for all.
+  std::size_t last_reset = drained_.size();
+  for (std::size_t i = 0; i < drained_.size(); ++i)
+    if (std::holds_alternative<ResetCommand>(drained_[i].action)) last_reset = i;
+  for (std::size_t i = 0; i < drained_.size(); ++i)
+    if (i == last_reset || !std::holds_alternative<ResetCommand>(drained_[i].action)) apply(world, drained_[i]);
 
   const Clock::time_point now = Clock::now();
   if (now < next_snapshot_) return;

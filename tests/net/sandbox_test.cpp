@@ -217,3 +217,20 @@ TEST_CASE(
   CHECK_FALSE(refused.paused);
   CHECK(refused.time_scale_set == 0.5);
 }
+
+TEST_CASE("a burst of resets is carried out as its last one and does not stall the snapshots of others",
+          "[net][sandbox]") {
+  ServerProcess server({"--scene", "dam-break"});  // 3000 balls placed at each start
+  Clients clients(server.port());
+  auto sender = clients.add(true);
+  auto other = clients.add(false);
+  const std::uint32_t start = sender->view().scene_start;
+  for (int i = 0; i < 300; ++i) sender->send(protocol::encode_reset("", i));
+  const std::uint64_t seen = other->stats().snapshots;
+  clients.run_for(milliseconds(1500));
+  INFO("scene starts " << sender->view().scene_start - start);
+  CHECK(sender->view().scene_start > start);
+  CHECK(sender->view().scene_start - start < 300);  // bursts coalesced
+  CHECK(other->stats().snapshots - seen >= 45);     // 60 a second, nearly undisturbed
+  CHECK(sender->stats().errors.empty());
+}
