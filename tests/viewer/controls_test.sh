@@ -7,6 +7,7 @@
 # Usage: controls_test.sh SERVER VIEWER OUT_DIR
 set -euo pipefail
 server=$1 viewer=$2 out=$3
+source "$(dirname "$0")/start_server.sh"
 
 for tool in xvfb-run xdotool; do
   if ! command -v "$tool" >/dev/null; then
@@ -18,16 +19,7 @@ rm -rf "$out"
 mkdir -p "$out/work"
 log=$out/server.log
 
-"$server" --port 0 --balls 300 --threads 1 --status-interval 0.25 2>"$log" &
-server_pid=$!
-trap 'kill "$server_pid" 2>/dev/null || true; wait "$server_pid" 2>/dev/null || true' EXIT
-port=""
-for _ in $(seq 200); do
-  port=$(sed -n 's/^listening on .*:\([0-9][0-9]*\)$/\1/p' "$log")
-  [ -n "$port" ] && break
-  sleep 0.05
-done
-[ -n "$port" ] || { echo "the server did not report its port:"; cat "$log"; exit 1; }
+start_server "$log" --balls 300 --threads 1 --status-interval 0.25
 
 # Inside the X session: start the viewer, wait for its window and its welcome,
 # then type each key and wait (at most 20 s) for the server's status line to show it.

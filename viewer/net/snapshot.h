@@ -44,7 +44,7 @@ struct Snapshot {
   bool paused = false;
   float time_scale_set = 0.0f;  // asked for (SetTimeScale); 0: the server did not say
   std::string scene;
-  std::uint32_t scene_start = 0;  // +1 per scene (re)start: ball ids restart at 0
+  std::uint32_t scene_start = 0;         // +1 per scene (re)start: ball ids restart at 0
   float kinetic_energy_per_ball = 0.0f;  // joules
   std::uint32_t contacts = 0;
   TankBounds tank;  // the scene's: the quantisation bounds (Welcome's when the server did not say)
