@@ -151,9 +151,13 @@ Outcome ClientProtocol::on_reply(const Reply& reply) {
     state_ = State::active;
     return out;
   }
-  if (const auto* control = std::get_if<ControlRefusedReply>(&reply.result))
-    return refuse(control->not_paused ? wire::ErrorCode::not_paused : wire::ErrorCode::tank_full, control->refusal,
-                  /*disconnect=*/false);
+  if (const auto* control = std::get_if<ControlRefusedReply>(&reply.result)) {
+    using Why = ControlRefusedReply::Why;
+    const wire::ErrorCode code = control->why == Why::not_paused    ? wire::ErrorCode::not_paused
+                                 : control->why == Why::fewer_balls ? wire::ErrorCode::tank_full
+                                                                    : wire::ErrorCode::server_busy;
+    return refuse(code, control->refusal, /*disconnect=*/false);
+  }
   const auto& added = std::get<BallsAddedReply>(reply.result);
   if (added.refusal.empty()) return out;
   // World::add_balls's refusal already says how many were added and why no more.

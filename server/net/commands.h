@@ -63,7 +63,12 @@ struct BallsAddedReply {
 // A control the physics thread could not fully carry out, and why; nothing is
 // sent when it was done.
 struct ControlRefusedReply {
-  bool not_paused = false;  // true: a Step while running (nothing done); false: a scene took fewer balls than asked
+  enum class Why {
+    not_paused,   // a Step while running: nothing done
+    fewer_balls,  // the scene started with fewer balls than asked
+    too_soon      // a Reset before the last one's spacing was up: nothing done
+  };
+  Why why = Why::not_paused;
   std::string refusal;
 };
 

@@ -82,13 +82,25 @@ void PhysicsLink::apply(World& world, const Command& command) {
                    if (control_.paused)
                      control_.steps_to_run += step.count;
                    else
-                     reply_({client, ControlRefusedReply{true, "Step works only while paused; pause first"}});
+                     reply_({client, ControlRefusedReply{ControlRefusedReply::Why::not_paused,
+                                                         "Step works only while paused; pause first"}});
                  },
                  [&](const ResetCommand& reset) {
+                   const Clock::time_point start = Clock::now();
+                   if (start < next_reset_) {
+                     reply_({client, ControlRefusedReply{ControlRefusedReply::Why::too_soon,
+                                                         "Reset refused: it came too soon after the last one "
+                                                         "(restarts may take a fifth of the physics at most); "
+                                                         "try again"}});
+                     return;
+                   }
                    // Asked-for steps belonged to the old start; a pause holds the new one still.
                    control_.steps_to_run = 0;
                    std::string refusal = scene_.start(world, reset.scene, reset.seed);
-                   if (!refusal.empty()) reply_({client, ControlRefusedReply{false, std::move(refusal)}});
+                   const Clock::time_point end = Clock::now();
+                   next_reset_ = end + kResetSpacing * (end - start);
+                   if (!refusal.empty())
+                     reply_({client, ControlRefusedReply{ControlRefusedReply::Why::fewer_balls, std::move(refusal)}});
                  },
                  [&](const TimeScaleCommand& scale) { control_.time_scale = scale.scale; },
              },

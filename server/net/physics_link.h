@@ -54,6 +54,10 @@ class PhysicsLink {
   // The figures pass over every ball and contact: ten times a second is
   // plenty for a plot, and keeps a large scene's snapshots cheap.
   static constexpr std::chrono::milliseconds kFiguresPeriod{100};
+  // A restart costs what filling its scene costs; the next may come only
+  // after this many times that, so however often clients ask, restarts take
+  // at most a fifth of the physics thread.
+  static constexpr int kResetSpacing = 4;
 
   CommandQueue& queue_;
   const std::atomic<int>& viewers_;
@@ -73,6 +77,7 @@ class PhysicsLink {
   std::uint32_t figures_start_ = 0;  // the scene start they were measured in
   float kinetic_energy_per_ball_ = 0.0f;
   std::uint32_t contacts_ = 0;
+  Clock::time_point next_reset_ = Clock::time_point::min();
 };
 
 }  // namespace fishtank::net
