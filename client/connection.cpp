@@ -87,13 +87,16 @@ void Connection::handle(const wire::Message& message) {
       worker_threads_ = w.worker_threads();
       tank_.min = {w.tank_min()->x(), w.tank_min()->y(), w.tank_min()->z()};
       tank_.max = {w.tank_max()->x(), w.tank_max()->y(), w.tank_max()->z()};
+      may_control_ = w.may_control();
+      control_policy_ = w.control_policy() ? w.control_policy()->str() : std::string();
       break;
     }
     case wire::Payload::BallKinds: {
       const wire::BallKinds& k = *message.payload_as_BallKinds();
-      if (k.first_new_ball() != view_.kinds.size())
+      // Earlier than expected is a scene's new start (kinds from there on are replaced); later is a gap.
+      if (k.first_new_ball() > view_.kinds.size())
         stats_.errors.push_back("BallKinds starts at ball " + std::to_string(k.first_new_ball()) + ", expected " +
-                                std::to_string(view_.kinds.size()));
+                                std::to_string(view_.kinds.size()) + " at most");
       view_.kinds.resize(k.first_new_ball());
       view_.kinds.insert(view_.kinds.end(), k.kinds()->begin(), k.kinds()->end());
       break;
@@ -111,6 +114,18 @@ void Connection::handle(const wire::Message& message) {
       view_.threads_stepping = s.threads_stepping();
       view_.time_scale = s.time_scale();
       view_.ball_count = s.ball_count();
+      view_.physics_steps = s.physics_steps();
+      view_.paused = s.paused();
+      view_.time_scale_set = s.time_scale_set();
+      view_.scene = s.scene() ? s.scene()->str() : std::string();
+      if (s.scene_start() != view_.scene_start) view_.positions.clear();  // other balls: nothing to compare
+      view_.scene_start = s.scene_start();
+      view_.kinetic_energy_per_ball = s.kinetic_energy_per_ball();
+      view_.contacts = s.contacts();
+      if (s.tank_min()) {  // decode_frame checked that both are present and ordered
+        tank_.min = {s.tank_min()->x(), s.tank_min()->y(), s.tank_min()->z()};
+        tank_.max = {s.tank_max()->x(), s.tank_max()->y(), s.tank_max()->z()};
+      }
       const std::size_t common = std::min<std::size_t>(view_.positions.size(), s.positions()->size()) / 3;
       std::size_t at_rest = 0, small = 0;
       for (std::size_t b = 0; b < common; ++b) {

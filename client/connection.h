@@ -40,6 +40,13 @@ struct WorldView {
   float load = 0.0f;
   std::uint32_t threads_stepping = 0;  // 0: the server did not say
   float time_scale = 0.0f;             // simulated seconds per wall second; 0: the server did not say
+  std::uint32_t physics_steps = 0;
+  bool paused = false;
+  float time_scale_set = 0.0f;  // asked for; 0: the server did not say
+  std::string scene;
+  std::uint32_t scene_start = 0;  // +1 per scene (re)start: ball ids restart
+  float kinetic_energy_per_ball = 0.0f;
+  std::uint32_t contacts = 0;
   std::uint32_t ball_count = 0;
   std::vector<std::uint16_t> positions;  // quantised, 3 per ball (protocol/quantize.h)
   std::vector<std::uint8_t> kinds;       // by ball id, from BallKinds
@@ -62,7 +69,10 @@ class Connection : public std::enable_shared_from_this<Connection> {
   const std::string& close_reason() const { return close_reason_; }
   std::optional<std::uint32_t> player_id() const { return player_id_; }
   std::uint32_t worker_threads() const { return worker_threads_; }  // from Welcome: the most a step may use
+  // The newest snapshot's tank (Welcome's until a snapshot says).
   const TankBounds& tank() const { return tank_; }
+  bool may_control() const { return may_control_; }  // from Welcome
+  const std::string& control_policy() const { return control_policy_; }
   const ConnectionStats& stats() const { return stats_; }
   const WorldView& view() const { return view_; }
   // The newest position of a player sphere, if the newest snapshot has it.
@@ -89,6 +99,8 @@ class Connection : public std::enable_shared_from_this<Connection> {
   std::optional<std::uint32_t> player_id_;
   std::uint32_t worker_threads_ = 0;
   TankBounds tank_;
+  bool may_control_ = false;
+  std::string control_policy_;
   ConnectionStats stats_;
   WorldView view_;
   std::chrono::steady_clock::time_point epoch_ = std::chrono::steady_clock::now();

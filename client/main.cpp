@@ -32,6 +32,11 @@ int main(int argc, char** argv) {
                         {"threads_stepping", s.threads_stepping},
                         {"worker_threads", s.worker_threads},
                         {"time_scale", s.time_scale},
+                        {"time_scale_set", s.time_scale_set},
+                        {"paused", s.paused},
+                        {"scene", s.scene},
+                        {"scene_start", s.scene_start},
+                        {"physics_steps", s.physics_steps},
                         {"at_rest_fraction", s.at_rest_fraction},
                         {"int8_delta_fraction", s.int8_delta_fraction},
                         {"dropped", s.dropped},
@@ -43,7 +48,8 @@ int main(int argc, char** argv) {
               << s.snapshot_rate_hz << " Hz and " << s.bytes_per_s / 1e3 << " kB/s per client); rtt " << s.rtt_ms
               << " ms; " << s.balls << " balls; server " << std::lround(s.steps_per_s) << " steps/s, load "
               << std::lround(100.0 * s.load) << " % on " << s.threads_stepping << " of " << s.worker_threads
-              << " threads, time scale " << s.time_scale << "\n";
+              << " threads, time scale " << s.time_scale << " (set " << s.time_scale_set << "); scene " << s.scene
+              << (s.paused ? ", paused" : "") << "\n";
     for (const std::string& e : s.error_messages) std::cout << "error: " << e << "\n";
   }
   if (s.dropped > 0) {

@@ -41,7 +41,10 @@ bool split_host_port(const std::string& text, std::string& host, std::uint16_t& 
 ClientParse parse_client_options(int argc, const char* const argv[]) {
   ClientOptions o;
   std::string connect = "127.0.0.1:7878", move;
-  std::int64_t clients = 1, add = 0;
+  std::int64_t clients = 1, add = 0, step = 0, seed = -1;
+  std::string scene;
+  float time_scale = 0.0f;
+  bool reset = false, pause = false, resume = false;
 
   po::options_description flags("Options");
   flags.add_options()("help,h", "print this help and exit")("connect", po::value(&connect)->default_value(connect),
@@ -53,6 +56,16 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
       "for", po::value(&o.script.move_for)->default_value(o.script.move_for), "seconds to move before stopping")(
       "duration", po::value(&o.script.duration)->default_value(o.script.duration), "seconds to stay connected")(
       "json", po::bool_switch(&o.json), "print one JSON summary on stdout");
+  po::options_description controls(
+      "Sandbox controls (sent once by the first client; the server's --control says who may)");
+  controls.add_options()("scene", po::value(&scene), "start this scene: tank, wide, dam-break or drop")(
+      "reset", po::bool_switch(&reset), "start the scene running again")(
+      "seed", po::value(&seed), "random seed for --reset or --scene, >= 0 (default: the scene's last)")(
+      "time-scale", po::value(&time_scale), "simulated seconds per wall second, 0.1 .. 1")(
+      "pause", po::bool_switch(&pause), "pause the simulation")("resume", po::bool_switch(&resume),
+                                                                "resume a paused simulation")(
+      "step", po::value(&step)->default_value(0), "steps to run while paused (with --pause, or on a paused server)");
+  flags.add(controls);
 
   ClientParse result;
   auto fail = [&result](const std::string& why) {
@@ -71,8 +84,11 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
     std::ostringstream help;
     help << "fishtank-client: connects to a fishtank-server, runs a short script and reports what it received.\n\n"
          << "Usage: fishtank-client [--connect host:port] [--clients K] [--observer] [--add N]\n"
-         << "                       [--move x,y,z --for T] [--duration T] [--json]\n\n"
-         << "Example: fishtank-client --clients 8 --add 1000 --move 2,0,0 --for 1 --duration 5 --json\n\n"
+         << "                       [--move x,y,z --for T] [--duration T] [--json]\n"
+         << "                       [--scene NAME | --reset] [--seed S] [--time-scale X] [--pause | --resume] [--step "
+            "N]\n\n"
+         << "Example: fishtank-client --clients 8 --add 1000 --move 2,0,0 --for 1 --duration 5 --json\n"
+         << "         fishtank-client --scene drop --seed 3 --pause --step 500 --duration 2 --json\n\n"
          << flags;
     result.message = help.str();
     return result;
@@ -90,6 +106,21 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   if (!std::isfinite(o.script.move_for) || o.script.move_for < 0.0) return fail("--for must be seconds >= 0");
   if (!std::isfinite(o.script.duration) || o.script.duration <= 0.0 || o.script.duration > 86400.0)
     return fail("--duration must be between 0 and 86400 seconds");
+  if (pause && resume) return fail("--pause and --resume contradict each other; give one");
+  if (step < 0 || step > protocol::kMaxStepsPerRequest)
+    return fail("--step must be between 0 and " + std::to_string(protocol::kMaxStepsPerRequest));
+  if (!vm["time-scale"].empty() && !(time_scale >= protocol::kMinTimeScale && time_scale <= protocol::kMaxTimeScale))
+    return fail("--time-scale must be between 0.1 and 1, got " + std::to_string(time_scale));
+  if (!vm["scene"].empty() && (scene.empty() || scene.size() > protocol::kMaxSceneNameBytes))
+    return fail("--scene wants a scene's name (tank, wide, dam-break or drop)");
+  if (!vm["seed"].empty() && seed < 0) return fail("--seed must be >= 0");
+  if (!vm["seed"].empty() && vm["scene"].empty() && !reset) return fail("--seed goes with --reset or --scene");
+  if (!vm["scene"].empty()) o.script.scene = scene;
+  if (!vm["seed"].empty()) o.script.seed = static_cast<std::uint64_t>(seed);
+  if (!vm["time-scale"].empty()) o.script.time_scale = time_scale;
+  if (pause || resume) o.script.pause = pause;
+  o.script.reset = reset;
+  o.script.step = static_cast<std::uint32_t>(step);
   o.script.clients = static_cast<int>(clients);
   o.script.add = static_cast<std::uint32_t>(add);
   result.options = o;

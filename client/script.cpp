@@ -43,6 +43,11 @@ Summary summarise(const std::vector<std::shared_ptr<Connection>>& connections, d
       s.load = c->view().load;
       s.threads_stepping = c->view().threads_stepping;
       s.time_scale = c->view().time_scale;
+      s.time_scale_set = c->view().time_scale_set;
+      s.paused = c->view().paused;
+      s.scene = c->view().scene;
+      s.scene_start = c->view().scene_start;
+      s.physics_steps = c->view().physics_steps;
       s.worker_threads = c->worker_threads();
       s.at_rest_fraction = st.at_rest_fraction;
       s.int8_delta_fraction = st.int8_delta_fraction;
@@ -58,6 +63,16 @@ Summary summarise(const std::vector<std::shared_ptr<Connection>>& connections, d
     s.rtt_ms = rtts[rtts.size() / 2];
   }
   return s;
+}
+
+// The sandbox's controls the script asks for, in the order they are sent.
+std::vector<protocol::Frame> control_frames(const Script& script) {
+  std::vector<protocol::Frame> frames;
+  if (script.scene || script.reset) frames.push_back(protocol::encode_reset(script.scene.value_or(""), script.seed));
+  if (script.time_scale) frames.push_back(protocol::encode_set_time_scale(*script.time_scale));
+  if (script.pause) frames.push_back(protocol::encode_pause(*script.pause));
+  if (script.step > 0) frames.push_back(protocol::encode_step(script.step));
+  return frames;
 }
 
 }  // namespace
@@ -82,7 +97,7 @@ Summary run_script(const Script& script) {
   }
 
   const Clock::time_point start = Clock::now();
-  bool added = false;
+  bool added = false;  // the controls and --add were sent
   // Per connection: 0 not moving yet, 1 moving, 2 stopped after --for seconds.
   std::vector<int> move_phase(connections.size(), 0);
   int tick = 0;
@@ -97,8 +112,9 @@ Summary run_script(const Script& script) {
     for (std::size_t i = 0; i < connections.size(); ++i)
       if (dropped_at[i] < 0.0 && connections[i]->closed()) dropped_at[i] = t;
     if (std::all_of(dropped_at.begin(), dropped_at.end(), [](double d) { return d >= 0.0; })) return;  // all gone
-    if (!added && script.add > 0 && connections.front()->welcomed()) {
-      connections.front()->send(protocol::encode_add_balls(script.add));
+    if (!added && connections.front()->welcomed()) {
+      for (protocol::Frame& frame : control_frames(script)) connections.front()->send(std::move(frame));
+      if (script.add > 0) connections.front()->send(protocol::encode_add_balls(script.add));
       added = true;
     }
     for (std::size_t i = 0; script.move && i < connections.size(); ++i) {

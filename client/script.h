@@ -1,6 +1,7 @@
 #pragma once
 // A scripted session against a server: K connections on one thread, each says
-// Hello; the first asks for --add balls; those with a player sphere move it at
+// Hello; the first sends the sandbox's controls (scene or reset, time scale,
+// pause or resume, step: in that order) and then asks for --add balls; those with a player sphere move it at
 // --move for --for seconds; every connection pings four times a second; after
 // --duration seconds everything is summed up.
 
@@ -22,6 +23,13 @@ struct Script {
   std::optional<Vec3> move;
   double move_for = 1.0;  // seconds
   double duration = 3.0;  // seconds
+  // The sandbox's controls, sent once by the first connection.
+  std::optional<std::string> scene;   // Reset to this scene
+  bool reset = false;                 // Reset the scene running (when no scene is given)
+  std::optional<std::uint64_t> seed;  // of the reset or scene
+  std::optional<float> time_scale;
+  std::optional<bool> pause;  // true: Pause, false: resume
+  std::uint32_t step = 0;     // steps to run while paused
 };
 
 struct Summary {
@@ -37,7 +45,12 @@ struct Summary {
   double load = 0.0;
   std::uint32_t threads_stepping = 0;  // 0: not reported
   std::uint32_t worker_threads = 0;
-  double time_scale = 0.0;           // simulated seconds per wall second; 0: not reported
+  double time_scale = 0.0;      // simulated seconds per wall second; 0: not reported
+  double time_scale_set = 0.0;  // asked for; 0: not reported
+  bool paused = false;
+  std::string scene;
+  std::uint32_t scene_start = 0;
+  std::uint32_t physics_steps = 0;
   double at_rest_fraction = 0.0;     // in that newest snapshot (ConnectionStats::at_rest_fraction)
   double int8_delta_fraction = 0.0;  // likewise (ConnectionStats::int8_delta_fraction)
   std::vector<std::string> error_messages;

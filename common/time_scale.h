@@ -8,7 +8,11 @@ namespace fishtank {
 // ordinary jitter of a paced loop, not a shortfall worth reporting.
 inline constexpr double kSlowMotionBelow = 0.98;
 
-// A time scale of 0 (or less) means none was reported.
-inline bool slow_motion(double time_scale) { return time_scale > 0.0 && time_scale < kSlowMotionBelow; }
+// A time scale of 0 (or less) means none was reported. asked is the time
+// scale people set (RunControl::time_scale): only a shortfall against it is
+// slow motion, a clock they slowed on purpose is not.
+inline bool slow_motion(double time_scale, double asked = 1.0) {
+  return time_scale > 0.0 && time_scale < kSlowMotionBelow * asked;
+}
 
 }  // namespace fishtank

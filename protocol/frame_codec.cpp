@@ -1,6 +1,7 @@
 #include "protocol/frame_codec.h"
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 namespace fishtank::protocol {
@@ -27,6 +28,11 @@ bool finite(const wire::Vec3f* v) {
   return v && std::isfinite(v->x()) && std::isfinite(v->y()) && std::isfinite(v->z());
 }
 
+// Finite corners with lo below hi on every axis.
+bool ordered_box(const wire::Vec3f* lo, const wire::Vec3f* hi) {
+  return finite(lo) && finite(hi) && lo->x() < hi->x() && lo->y() < hi->y() && lo->z() < hi->z();
+}
+
 DecodeResult failure(DecodeStatus status, std::string why) { return {status, nullptr, std::move(why)}; }
 
 bool accepted_by(wire::Payload type, Direction to) {
@@ -35,6 +41,10 @@ bool accepted_by(wire::Payload type, Direction to) {
     case wire::Payload::PlayerInput:
     case wire::Payload::AddBalls:
     case wire::Payload::Ping:
+    case wire::Payload::Pause:
+    case wire::Payload::Step:
+    case wire::Payload::Reset:
+    case wire::Payload::SetTimeScale:
       return to == Direction::to_server;
     case wire::Payload::Welcome:
     case wire::Payload::BallKinds:
@@ -69,14 +79,36 @@ std::string check_values(const wire::Message& m) {
     }
     case wire::Payload::Ping:
     case wire::Payload::Pong:
+    case wire::Payload::Pause:
       return {};
+    case wire::Payload::Step: {
+      const std::uint32_t count = m.payload_as_Step()->count();
+      if (count < 1 || count > kMaxStepsPerRequest)
+        return "Step.count must be between 1 and " + std::to_string(kMaxStepsPerRequest) + ", got " +
+               std::to_string(count);
+      return {};
+    }
+    case wire::Payload::Reset: {
+      const auto* scene = m.payload_as_Reset()->scene();
+      if (scene && scene->size() > kMaxSceneNameBytes)
+        return "Reset.scene is " + std::to_string(scene->size()) + " bytes; scene names are at most " +
+               std::to_string(kMaxSceneNameBytes);
+      return {};
+    }
+    case wire::Payload::SetTimeScale: {
+      const float scale = m.payload_as_SetTimeScale()->scale();
+      // Written so that NaN fails too.
+      if (scale >= kMinTimeScale && scale <= kMaxTimeScale) return {};
+      char why[96];
+      std::snprintf(why, sizeof why, "SetTimeScale.scale must be between %g and %g, got %g", kMinTimeScale,
+                    kMaxTimeScale, scale);
+      return why;
+    }
     case wire::Payload::Welcome: {
       const wire::Welcome& w = *m.payload_as_Welcome();
       if (!w.server_variant() || !w.simd_level()) return "Welcome lacks server_variant or simd_level";
       if (!finite(w.tank_min()) || !finite(w.tank_max())) return "Welcome tank bounds are missing or not finite";
-      if (!(w.tank_min()->x() < w.tank_max()->x() && w.tank_min()->y() < w.tank_max()->y() &&
-            w.tank_min()->z() < w.tank_max()->z()))
-        return "Welcome tank_min is not below tank_max on every axis";
+      if (!ordered_box(w.tank_min(), w.tank_max())) return "Welcome tank_min is not below tank_max on every axis";
       if (!std::isfinite(w.dt()) || w.dt() <= 0.0f) return "Welcome.dt is not a positive number";
       if (!w.ball_kinds() || w.ball_kinds()->size() == 0 || w.ball_kinds()->size() > 256)
         return "Welcome.ball_kinds must list 1 to 256 kinds";
@@ -104,8 +136,12 @@ std::string check_values(const wire::Message& m) {
       for (const wire::Vec3f* p : *s.player_positions())
         if (!finite(p)) return "Snapshot has a non-finite player position";
       if (!std::isfinite(s.sim_time()) || !std::isfinite(s.steps_per_s()) || !std::isfinite(s.load()) ||
-          !std::isfinite(s.time_scale()))
-        return "Snapshot has a non-finite time, rate, load or time scale";
+          !std::isfinite(s.time_scale()) || !std::isfinite(s.time_scale_set()) ||
+          !std::isfinite(s.kinetic_energy_per_ball()))
+        return "Snapshot has a non-finite time, rate, load, time scale or energy";
+      if (!s.tank_min() != !s.tank_max()) return "Snapshot has one tank corner without the other";
+      if (s.tank_min() && !ordered_box(s.tank_min(), s.tank_max()))
+        return "Snapshot tank bounds are not finite, or tank_min is not below tank_max on every axis";
       return {};
     }
     case wire::Payload::Error:
@@ -140,6 +176,31 @@ Frame encode_ping(std::uint32_t client_time_us) {
   return finish(b, wire::CreatePing(b, client_time_us));
 }
 
+Frame encode_pause(bool paused) {
+  flatbuffers::FlatBufferBuilder b(64);
+  return finish(b, wire::CreatePause(b, paused));
+}
+
+Frame encode_step(std::uint32_t count) {
+  flatbuffers::FlatBufferBuilder b(64);
+  return finish(b, wire::CreateStep(b, count));
+}
+
+Frame encode_reset(std::string_view scene, std::optional<std::uint64_t> seed) {
+  flatbuffers::FlatBufferBuilder b(128);
+  flatbuffers::Offset<flatbuffers::String> name;
+  if (!scene.empty()) name = b.CreateString(scene.data(), scene.size());
+  wire::ResetBuilder reset(b);
+  if (!scene.empty()) reset.add_scene(name);
+  if (seed) reset.add_seed(*seed);
+  return finish(b, reset.Finish());
+}
+
+Frame encode_set_time_scale(float scale) {
+  flatbuffers::FlatBufferBuilder b(64);
+  return finish(b, wire::CreateSetTimeScale(b, scale));
+}
+
 Frame encode_welcome(const WelcomeInfo& info) {
   flatbuffers::FlatBufferBuilder b(512);
   const auto variant = b.CreateString(info.server_variant);
@@ -147,10 +208,11 @@ Frame encode_welcome(const WelcomeInfo& info) {
   std::vector<wire::BallKindInfo> kinds;
   for (const BallKind& k : kBallKinds) kinds.emplace_back(k.diameter, k.mass, k.rgb[0], k.rgb[1], k.rgb[2]);
   const auto kinds_offset = b.CreateVectorOfStructs(kinds);
+  const auto policy = b.CreateString(info.control_policy);
   const wire::Vec3f tank_min = to_wire(info.tank.min), tank_max = to_wire(info.tank.max);
   return finish(b, wire::CreateWelcome(b, kProtocolVersion, info.client_id, variant, simd, info.worker_threads,
                                        &tank_min, &tank_max, info.dt, kinds_offset, info.player_id.has_value(),
-                                       info.player_id.value_or(0), info.snapshot_rate_hz));
+                                       info.player_id.value_or(0), info.snapshot_rate_hz, policy, info.may_control));
 }
 
 Frame encode_ball_kinds(std::uint32_t first_new_ball, const std::uint8_t* kinds, std::size_t count) {
@@ -170,9 +232,13 @@ Frame encode_snapshot(const SnapshotHeader& header, const std::uint16_t* quantis
   std::vector<wire::Vec3f> player_wire(players);
   for (std::size_t i = 0; i < players; ++i) player_wire[i] = to_wire(player_positions[i]);
   const auto player_offset = b.CreateVectorOfStructs(player_wire);
+  const auto scene = b.CreateString(header.scene);
+  const wire::Vec3f tank_min = to_wire(header.tank.min), tank_max = to_wire(header.tank.max);
   return finish(
       b, wire::CreateSnapshot(b, header.tick, header.sim_time, header.physics_steps, header.steps_per_s, header.load,
-                              ball_count, positions, ids, player_offset, header.threads_stepping, header.time_scale));
+                              ball_count, positions, ids, player_offset, header.threads_stepping, header.time_scale,
+                              header.paused, header.time_scale_set, scene, header.scene_start, &tank_min, &tank_max,
+                              header.kinetic_energy_per_ball, header.contacts));
 }
 
 Frame encode_error(wire::ErrorCode code, std::string_view message) {

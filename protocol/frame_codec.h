@@ -42,6 +42,11 @@ inline constexpr std::uint32_t kMaxClientFrameBytes = 1u << 20;
 inline constexpr std::uint32_t kMaxServerFrameBytes = 64u << 20;
 inline constexpr std::uint32_t kMaxAddBallsPerRequest = 100'000;
 inline constexpr std::size_t kMaxClientNameBytes = 64;
+inline constexpr std::uint32_t kMaxStepsPerRequest = 100'000;
+// The slowest and fastest clock people may ask for (SetTimeScale).
+inline constexpr float kMinTimeScale = 0.1f;
+inline constexpr float kMaxTimeScale = 1.0f;
+inline constexpr std::size_t kMaxSceneNameBytes = 32;
 
 using Frame = std::vector<std::uint8_t>;  // one complete frame, length prefix included
 using SharedFrame = std::shared_ptr<const Frame>;
@@ -53,6 +58,11 @@ Frame encode_hello(std::string_view client_name, bool wants_player, std::uint32_
 Frame encode_player_input(std::uint32_t sequence, Vec3 velocity);
 Frame encode_add_balls(std::uint32_t count);
 Frame encode_ping(std::uint32_t client_time_us);
+Frame encode_pause(bool paused);
+Frame encode_step(std::uint32_t count);
+// An empty scene restarts the scene running; no seed keeps the scene's last seed.
+Frame encode_reset(std::string_view scene, std::optional<std::uint64_t> seed);
+Frame encode_set_time_scale(float scale);
 
 // ---- encoding: server -> client ----
 struct WelcomeInfo {
@@ -64,6 +74,8 @@ struct WelcomeInfo {
   float dt = 0.0f;
   std::optional<std::uint32_t> player_id;  // empty: the client observes
   float snapshot_rate_hz = 0.0f;
+  std::string control_policy;  // who may pause, step, reset and set the time scale, in words
+  bool may_control = false;    // whether this client may
 };
 Frame encode_welcome(const WelcomeInfo& info);
 
@@ -78,6 +90,13 @@ struct SnapshotHeader {
   float load = 0.0f;
   std::uint32_t threads_stepping = 0;  // 0: not reported
   float time_scale = 0.0f;             // simulated seconds per wall second; 0: not reported
+  bool paused = false;
+  float time_scale_set = 0.0f;  // asked for (SetTimeScale); 0: not reported
+  std::string scene;
+  std::uint32_t scene_start = 0;
+  TankBounds tank;  // the running scene's: the quantisation bounds
+  float kinetic_energy_per_ball = 0.0f;
+  std::uint32_t contacts = 0;
 };
 // quantised holds 3 * ball_count values (protocol/quantize.h), in ball-id order;
 // player_ids and player_positions hold `players` entries each.

@@ -19,6 +19,7 @@
 #include "server/net/network_service.h"
 #include "server/options.h"
 #include "server/realtime_loop.h"
+#include "server/scenes/active_scene.h"
 
 #ifndef FISHTANK_SIMD
 #error "FISHTANK_SIMD must be defined (0: scalar twin, 1: SSE, 2: AVX2)"
@@ -78,14 +79,17 @@ std::string threads_text(int threads, int cores) {
   return text;
 }
 
-// Nothing while simulated time keeps up with the wall clock.
-std::string pace_text(const fishtank::LoopStatus& s) {
-  if (fishtank::slow_motion(s.time_scale)) {
-    char text[48];
+// Nothing while simulated time keeps up with the wall clock at the pace asked for.
+std::string pace_text(const fishtank::LoopStatus& s, const fishtank::RunControl& control) {
+  if (control.paused) return "  paused";
+  char text[64] = "";
+  if (control.time_scale < 1.0) std::snprintf(text, sizeof text, "  time scale set to x%.2f", control.time_scale);
+  std::string pace = text;
+  if (fishtank::slow_motion(s.time_scale, control.time_scale)) {
     std::snprintf(text, sizeof text, "  slow motion x%.2f", s.time_scale);
-    return text;
+    return pace + text;
   }
-  return s.dropped_steps ? "  (falling behind real time)" : "";
+  return pace + (s.dropped_steps ? "  (falling behind)" : "");
 }
 
 fishtank::net::NetOptions net_options(const fishtank::ServerOptions& o) {
@@ -105,23 +109,33 @@ fishtank::net::ServerInfo server_info(const fishtank::World& world, const fishta
   info.tank = world.params().tank;
   info.dt = world.dt();
   info.snapshot_rate_hz = static_cast<float>(o.snapshot_rate);
+  info.control = o.control;
   return info;
+}
+
+fishtank::SceneChoice scene_choice(const fishtank::ServerOptions& o) {
+  fishtank::SceneChoice choice;
+  choice.name = o.bench_spec.scene.name;
+  choice.seed = o.bench_spec.scene.seed;
+  if (o.balls_given) choice.balls = o.start_balls;
+  choice.max_balls = o.max_balls;
+  return choice;
 }
 
 int run_server(const fishtank::ServerOptions& o) {
   spdlog::set_default_logger(spdlog::stderr_logger_mt("fishtank-server"));
-  fishtank::World world(o.physics, kKernels, o.threads, o.bench_spec.scene.seed);
+  fishtank::ActiveScene scene(scene_choice(o));
+  fishtank::PhysicsParams params = o.physics;
+  params.tank = scene.first_tank();
+  fishtank::World world(params, kKernels, o.threads, o.bench_spec.scene.seed);
   world.set_thread_tuning(!o.fixed_threads);
-  if (o.max_balls > 0) world.set_max_balls(o.max_balls);
-  if (o.start_balls > 0) {
-    fishtank::AddResult added = world.add_balls(o.start_balls);
-    if (!added.refusal.empty()) std::cerr << "fishtank-server: " << added.refusal << "\n";
-  }
+  if (std::string refusal = scene.start(world); !refusal.empty()) std::cerr << "fishtank-server: " << refusal << "\n";
+  fishtank::RunControl control;
   const int cores = fishtank::WorkerPool::hardware_threads();
   std::fprintf(stderr, "fishtank-server (%s, %s, %s): dt = %.3g s, k = %g N/m, e = %g; Ctrl-C stops\n",
                kKernels.variant, kKernels.simd, threads_text(world.threads(), cores).c_str(), world.dt(),
                o.physics.stiffness, o.physics.restitution);
-  fishtank::net::NetworkService network(net_options(o), server_info(world, o), g_stop);
+  fishtank::net::NetworkService network(net_options(o), server_info(world, o), control, scene, g_stop);
   if (std::string error = network.start(); !error.empty()) {
     std::cerr << "fishtank-server: " << error << "\n";
     return 1;
@@ -138,16 +152,18 @@ int run_server(const fishtank::ServerOptions& o) {
   loop.duration = o.duration;
   loop.status_interval = o.status_interval;
   loop.batch_seconds = std::min(0.004, 1.0 / o.snapshot_rate);  // 4 ms, or one snapshot interval if shorter
+  loop.control = &control;
   loop.at_step_boundary = [&](fishtank::World& w, const fishtank::LoopStatus& s) {
     network.at_step_boundary(w, s);
     if (o.record_path.empty() || w.steps() < next_frame) return;
     if (std::string error = recorder.write_frame(w); !error.empty()) spdlog::error("{}", error);
     next_frame = w.steps() + o.record_every;
   };
-  loop.on_status = [&network, cores](const fishtank::World& w, const fishtank::LoopStatus& s) {
-    std::fprintf(stderr, "t = %7.1f s  balls %5u (+%u queued)  %6.0f steps/s  load %5.1f %% on %s  %s%s\n", w.time(),
-                 w.ball_count(), w.pending(), s.steps_per_s, 100.0 * s.load, threads_text(s.threads, cores).c_str(),
-                 network.status().c_str(), pace_text(s).c_str());
+  loop.on_status = [&network, &control, &scene, cores](const fishtank::World& w, const fishtank::LoopStatus& s) {
+    std::fprintf(stderr, "t = %7.1f s  balls %5u (+%u queued)  %6.0f steps/s  load %5.1f %% on %s  %s  scene %s%s\n",
+                 w.time(), w.ball_count(), w.pending(), s.steps_per_s, 100.0 * s.load,
+                 threads_text(s.threads, cores).c_str(), network.status().c_str(), scene.name().c_str(),
+                 pace_text(s, control).c_str());
   };
   fishtank::run_realtime(world, loop, g_stop);
   std::cerr << "fishtank-server: stopped after " << world.steps() << " steps, " << world.ball_count() << " balls\n";

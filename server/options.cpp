@@ -4,17 +4,24 @@
 #include <cmath>
 #include <sstream>
 
-#include "server/bench/scenes.h"
+#include "common/scene_names.h"
 #include "server/physics/worker_pool.h"
+#include "server/scenes/scene_presets.h"
 
 namespace fishtank {
 
 namespace po = boost::program_options;
 
+namespace {
+std::string scene_help() {
+  return "scene to start with, which clients may switch live (also --bench's): " + scene_names_text();
+}
+}  // namespace
+
 ParseResult parse_server_options(int argc, const char* const argv[], const char* variant, bool threaded) {
   ServerOptions o;
   PhysicsParams defaults;
-  std::int64_t balls = -1, start_balls = o.start_balls, steps = static_cast<std::int64_t>(o.bench_spec.steps);
+  std::int64_t balls = -1, steps = static_cast<std::int64_t>(o.bench_spec.steps);
   std::int64_t threads = threaded ? WorkerPool::hardware_threads() : 1, max_balls = 0, seed = 1;
   std::int64_t steps_per_contact = defaults.steps_per_contact;
   double settle_time = 0.0;
@@ -28,7 +35,8 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
                : "worker threads (the scalar build uses 1)")("fixed-threads", po::bool_switch(&o.fixed_threads),
                                                              "always step on every --threads thread")(
       "seed", po::value(&seed)->default_value(seed), "random seed for spawning, >= 0")(
-      "balls", po::value(&balls), "balls to pour in at start (default 1000; with --bench, 6000)")(
+      "scene", po::value(&o.bench_spec.scene.name)->default_value("tank"), scene_help().c_str())(
+      "balls", po::value(&balls), "balls of every scene (default: the scene's, 1000 for tank; with --bench, 6000)")(
       "max-balls", po::value(&max_balls)->default_value(0), "most balls the tank may hold (0: its capacity, ~6100)")(
       "duration", po::value(&o.duration)->default_value(0.0), "stop after this many seconds (0: run until Ctrl-C)")(
       "status-interval", po::value(&o.status_interval)->default_value(1.0), "seconds between status lines");
@@ -44,13 +52,17 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "record-every", po::value(&record_every)->default_value(record_every), "steps between recorded frames");
 
   std::int64_t port = o.port, max_players = o.max_players;
+  std::string control = "players";
   po::options_description network("Network");
   network.add_options()("bind", po::value(&o.bind)->default_value(o.bind),
                         "address to listen on (127.0.0.1: this machine only; 0.0.0.0: every interface)")(
       "port", po::value(&port)->default_value(port), "TCP port (0: pick a free one and print it)")(
       "snapshot-rate", po::value(&o.snapshot_rate)->default_value(o.snapshot_rate),
       "snapshots per second sent to clients")("max-players", po::value(&max_players)->default_value(max_players),
-                                              "player spheres at most; later clients observe");
+                                              "player spheres at most; later clients observe")(
+      "control", po::value(&control)->default_value(control),
+      "who may pause, step, reset, switch scene and set the time scale: players (clients with a player sphere), "
+      "everyone or nobody");
 
   po::options_description physics("Physics");
   physics.add_options()("stiffness", po::value(&o.physics.stiffness)->default_value(defaults.stiffness, "25000"),
@@ -64,7 +76,6 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
 
   po::options_description bench("Benchmark");
   bench.add_options()("bench", po::bool_switch(&o.bench), "run unpaced without network and print one JSON object")(
-      "scene", po::value(&o.bench_spec.scene.name)->default_value("tank"), "benchmark scene: tank or wide")(
       "steps", po::value(&steps)->default_value(steps), "timed steps after settling")(
       "windows", po::value(&windows)->default_value(windows),
       "the timed steps are split into this many windows; rates are their median")(
@@ -78,7 +89,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   std::ostringstream help;
   help << "fishtank-server (" << variant << " variant): granular physics of balls in a fish tank.\n\n"
        << "Usage: fishtank-server [options]\n"
-       << "       fishtank-server --bench [--scene tank|wide] [--balls N] [--steps S] [--threads T]\n"
+       << "       fishtank-server --bench [--scene NAME] [--balls N] [--steps S] [--threads T]\n"
        << all;
   po::variables_map vm;
   try {
@@ -99,7 +110,10 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
     result.message = "fishtank-server: " + why;
     return result;
   };
-  if (balls == -1) balls = o.bench ? 6000 : start_balls;
+  if (!is_scene_name(o.bench_spec.scene.name))
+    return fail("unknown scene '" + o.bench_spec.scene.name + "'; the scenes are " + scene_names_text());
+  o.balls_given = balls != -1;
+  if (balls == -1) balls = o.bench ? 6000 : default_balls(o.bench_spec.scene.name);
   if (balls < 0 || balls > 10'000'000)
     return fail("--balls must be between 0 and 10000000, got " + std::to_string(balls));
   if (threads < 1 || threads > 1024)
@@ -123,8 +137,6 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
     return fail("--status-interval must be between 0.05 and 3600 seconds");
   if (!std::isfinite(settle_time) || settle_time < 0.0 || settle_time > 1e6)
     return fail("--settle-time must be between 0 and 1e6 simulated seconds");
-  if (!is_known_scene(o.bench_spec.scene.name))
-    return fail("unknown scene '" + o.bench_spec.scene.name + "'; the scenes are tank and wide");
   if (steps_per_contact < PhysicsParams::kMinStepsPerContact || steps_per_contact > 100000)
     return fail("--steps-per-contact must be between " + std::to_string(PhysicsParams::kMinStepsPerContact) +
                 " and 100000, got " + std::to_string(steps_per_contact));
@@ -135,6 +147,9 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   if (max_players < 0 || max_players > 1000)
     return fail("--max-players must be between 0 and 1000, got " + std::to_string(max_players));
 
+  const std::optional<ControlPolicy> policy = parse_control_policy(control);
+  if (!policy) return fail("--control must be players, everyone or nobody, got '" + control + "'");
+  o.control = *policy;
   o.port = static_cast<std::uint16_t>(port);
   o.max_players = static_cast<std::uint32_t>(max_players);
   o.physics.steps_per_contact = static_cast<int>(steps_per_contact);

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "server/bench/benchmark.h"
+#include "server/control_policy.h"
 #include "server/physics/params.h"
 
 namespace fishtank {
@@ -16,9 +17,10 @@ struct ServerOptions {
   // Steps choose between every thread and one by measurement unless fixed.
   bool fixed_threads = false;
   int threads = 1;
-  std::uint32_t start_balls = 1000;
-  std::uint32_t max_balls = 0;  // 0: the tank's capacity
-  double duration = 0.0;        // seconds of real time; 0: until interrupted
+  std::uint32_t start_balls = 1000;  // the scene's default unless --balls was given
+  bool balls_given = false;          // --balls applies to every scene a client switches to
+  std::uint32_t max_balls = 0;       // 0: the tank's capacity
+  double duration = 0.0;             // seconds of real time; 0: until interrupted
   double status_interval = 1.0;
   std::string dump_path;
   std::string lammps_dir;              // --export-lammps
@@ -31,6 +33,7 @@ struct ServerOptions {
   std::uint16_t port = 7878;  // 0: an ephemeral port, printed at start
   double snapshot_rate = 60.0;
   std::uint32_t max_players = 8;
+  ControlPolicy control = ControlPolicy::players;  // who may pause, step, reset, switch scene, set the time scale
 };
 
 struct ParseResult {

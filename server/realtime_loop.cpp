@@ -21,8 +21,10 @@ double seconds_between(Clock::time_point from, Clock::time_point to) {
 
 void run_realtime(World& world, const LoopOptions& options, const std::atomic<bool>& stop) {
   const double dt = world.dt();
+  RunControl real_time;
+  RunControl& control = options.control ? *options.control : real_time;
   const Clock::time_point start = Clock::now();
-  double sim_clock = 0.0;  // wall seconds of simulated time stepped so far
+  double sim_clock = 0.0;  // the wall time by which the steps done so far were due
   LoopStatus status;
   Clock::time_point window_start = start;
   std::uint64_t window_steps = 0;
@@ -31,19 +33,29 @@ void run_realtime(World& world, const LoopOptions& options, const std::atomic<bo
   while (!stop.load(std::memory_order_relaxed)) {
     const double now = seconds_between(start, Clock::now());
     if (options.duration > 0.0 && now >= options.duration) break;
-    if (now - sim_clock > kMaxLagSeconds) {
-      status.dropped_steps += static_cast<std::uint64_t>((now - sim_clock - kMaxLagSeconds) / dt);
-      sim_clock = now - kMaxLagSeconds;
-    }
     const Clock::time_point busy_start = Clock::now();
     if (options.at_step_boundary) options.at_step_boundary(world, status);
+    // A step is due every dt / time_scale of wall time; a paused world owes none.
+    const double wall_per_step = dt / control.time_scale;
+    if (control.paused) {
+      sim_clock = now;
+    } else if (now - sim_clock > kMaxLagSeconds) {
+      status.dropped_steps += static_cast<std::uint64_t>((now - sim_clock - kMaxLagSeconds) / wall_per_step);
+      sim_clock = now - kMaxLagSeconds;
+    }
     // Steps are due up to `now`, but the batch stops at its budget so that
     // snapshots, status and commands keep their rate whatever a step costs.
     const Clock::time_point budget_end =
         busy_start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.batch_seconds));
+    auto within_budget = [&](std::uint64_t done) { return done == 0 || Clock::now() < budget_end; };
     std::uint64_t batch_steps = 0;
-    for (; sim_clock + dt <= now && (batch_steps == 0 || Clock::now() < budget_end); sim_clock += dt, ++batch_steps)
-      world.step();
+    if (control.paused) {
+      for (; control.steps_to_run > 0 && within_budget(batch_steps); --control.steps_to_run, ++batch_steps)
+        world.step();
+    } else {
+      for (; sim_clock + wall_per_step <= now && within_budget(batch_steps); sim_clock += wall_per_step, ++batch_steps)
+        world.step();
+    }
     const Clock::time_point busy_end = Clock::now();
     const double busy = seconds_between(busy_start, busy_end);
     window_busy += busy;
@@ -61,10 +73,11 @@ void run_realtime(World& world, const LoopOptions& options, const std::atomic<bo
       status.dropped_steps = 0;
       window_busy = 0.0;
     }
+    if (control.paused && control.steps_to_run > 0) continue;  // asked-for steps run back to back
     // Sleep until a batch of steps is due rather than a single one, and wake
     // the worker threads a little before it: waking a sleeping thread costs
     // more than the batch would otherwise wait for.
-    const double next_batch = sim_clock + std::max(dt, options.batch_seconds);
+    const double next_batch = sim_clock + std::max(wall_per_step, options.batch_seconds);
     const double wait = next_batch - seconds_between(start, Clock::now());
     if (wait > kWakeLeadSeconds) std::this_thread::sleep_for(std::chrono::duration<double>(wait - kWakeLeadSeconds));
     world.wake_workers();

@@ -22,6 +22,17 @@ struct LoopStatus {
   double time_scale = 1.0;
 };
 
+// What people ask of the loop: pause, a few steps while paused, a slower
+// clock. Written between batches (at_step_boundary, on the loop's thread),
+// read by the loop before each batch.
+struct RunControl {
+  bool paused = false;
+  std::uint64_t steps_to_run = 0;  // while paused: steps asked for and not yet done
+  // Simulated seconds per wall second asked for, 0.1 .. 1; the loop's
+  // LoopStatus::time_scale is what it achieves (lower when overloaded).
+  double time_scale = 1.0;
+};
+
 struct LoopOptions {
   double duration = 0.0;  // seconds; 0 runs until stop is set
   double status_interval = 1.0;
@@ -36,6 +47,8 @@ struct LoopOptions {
   // batch_seconds, plus one step), with the latest status: the one place where
   // others may change the world (commands) or read it (snapshots).
   std::function<void(World&, const LoopStatus&)> at_step_boundary;
+  // Read before each batch, after at_step_boundary; null: always real time.
+  RunControl* control = nullptr;
 };
 
 void run_realtime(World& world, const LoopOptions& options, const std::atomic<bool>& stop);

@@ -18,6 +18,7 @@
 #include "viewer/frame_stats.h"
 #include "viewer/hud.h"
 #include "viewer/input.h"
+#include "viewer/live_plots.h"
 #include "viewer/net/client.h"
 #include "viewer/net/interpolation.h"
 #include "viewer/net/snapshot_buffer.h"
@@ -139,12 +140,15 @@ int run_viewer(const ViewerOptions& opt) {
     OrbitCamera camera;
     camera.frame(TankBounds{});
     FrameStats stats;
+    LivePlots plots;
+    std::string viewer_notice;
+    double viewer_notice_time = -1.0;
 
     glEnable(GL_DEPTH_TEST);
     glEnable(GL_CULL_FACE);
     glClearColor(0.055f, 0.066f, 0.09f, 1.0f);
 
-    bool show_tank = opt.tank_outline, show_help = false, show_stats = opt.hud;
+    bool show_tank = opt.tank_outline, show_help = false, show_stats = opt.hud, show_plots = opt.hud;
     std::vector<SphereInstance> instances;
     TankBounds framed;  // the camera frames the tank again only if a server's tank differs
     int frames_since_snapshot = 0;
@@ -162,7 +166,12 @@ int run_viewer(const ViewerOptions& opt) {
       if (a.toggle_help) show_help = !show_help;
       if (a.toggle_hud) show_stats = !show_stats;
       if (a.toggle_fullscreen) fullscreen.toggle();
+      if (a.toggle_plots) show_plots = !show_plots;
       if (a.add_balls) net.add_balls(kBallsPerPress);
+      const std::shared_ptr<const Snapshot> newest = snapshots.newest();
+      for (protocol::Frame& frame : sandbox_frames(a.sandbox, newest.get()))
+        net.send_command(std::move(frame));
+      if (newest) plots.add(*newest);
 
       input.drive_camera(camera);
       if (!opt.observer) net.set_velocity(input.movement(camera) * kPlayerSpeed);
@@ -175,7 +184,7 @@ int run_viewer(const ViewerOptions& opt) {
       int own = -1;
       instances.clear();
       if (have_frame && status.info) {
-        const TankBounds& tank = status.info->tank;
+        const TankBounds& tank = pair.to->tank;
         if (!same_box(framed, tank)) {
           camera.frame(tank);
           tank_outline.set_bounds(tank);
@@ -189,12 +198,15 @@ int run_viewer(const ViewerOptions& opt) {
       view.frame_ms = stats.frame_ms();
       view.cpu_ms = stats.cpu_ms();
       view.net = &status;
-      const std::shared_ptr<const Snapshot> newest = snapshots.newest();
       view.snapshot = newest.get();
       view.render_delay_ms = static_cast<float>(1e3 * snapshots.render_delay());
       view.observer = opt.observer;
       view.show_stats = show_stats;
       view.show_help = show_help;
+      view.show_plots = show_plots;
+      view.plots = &plots;
+      view.viewer_notice = viewer_notice;
+      view.viewer_notice_time = viewer_notice_time;
       view.now = frame_start;
       hud.build(view);
       const double cpu_seconds = thread_cpu_seconds() - cpu_start;
@@ -212,6 +224,13 @@ int run_viewer(const ViewerOptions& opt) {
       }
       if (show_tank) tank_outline.draw(view_proj);
       hud.render();
+      if (a.screenshot) {
+        const std::string path = new_screenshot_path();
+        viewer_notice = save_screenshot(path, width, height) ? "screenshot saved: " + path
+                                                             : "could not save a screenshot at " + path;
+        viewer_notice_time = frame_start;
+        std::fprintf(stderr, "fishtank-viewer: %s\n", viewer_notice.c_str());
+      }
 
       if (!opt.screenshot.empty()) {
         if (have_frame && ++frames_since_snapshot >= opt.frames) {

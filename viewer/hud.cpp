@@ -4,6 +4,7 @@
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
 
+#include <cfloat>
 #include <cstdarg>
 #include <cstdio>
 
@@ -66,6 +67,7 @@ void Hud::build(const HudView& v) {
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
   if (v.show_stats) stats(v);
+  if (v.show_plots && v.plots) live_plots(v);
   connection(v);
   if (v.show_help) help();
   ImGui::Render();
@@ -89,11 +91,13 @@ void Hud::stats(const HudView& v) {
   const bool live = fresh.live;
   if (s) {
     row(live, "Physics", "%.0f steps/s   load %.0f %%", s->steps_per_s, 100.0f * s->load);
-    row(live, "Time", "%s", time_scale_text(s->time_scale).c_str());
+    row(live, "Time", "%s", time_scale_text(s->time_scale, s->time_scale_set, s->paused).c_str());
+    row(live, "Scene", "%s (start %u)", s->scene.empty() ? "-" : s->scene.c_str(), s->scene_start);
     row(live, "Balls", "%u", s->ball_count);
   } else {
     row(live, "Physics", "-");
     row(live, "Time", "-");
+    row(live, "Scene", "-");
     row(live, "Balls", "-");
   }
   if (const ServerInfo* info = net.info.get()) {
@@ -113,8 +117,18 @@ void Hud::stats(const HudView& v) {
     row(live, "Player", "observing");
   else
     row(live, "Player", "yours is the white sphere with the amber ring");
+  if (const ServerInfo* info = net.info.get()) {
+    ImGui::PushTextWrapPos(520.0f);
+    row(live, "Control", "%s", control_text(info->may_control, info->control_policy).c_str());
+    ImGui::PopTextWrapPos();
+  }
   if (!live) ImGui::TextColored(kWarn, "%s", fresh.note.c_str());
   ImGui::TextColored(kDim, "H: help");
+  if (!v.viewer_notice.empty() && v.now - v.viewer_notice_time < kNoticeSeconds) {
+    ImGui::PushTextWrapPos(520.0f);
+    ImGui::TextUnformatted(v.viewer_notice.c_str());
+    ImGui::PopTextWrapPos();
+  }
   if (!net.notice.empty() && v.now - net.notice_time < kNoticeSeconds) {
     ImGui::PushTextWrapPos(520.0f);
     ImGui::TextColored(kWarn, "%s", net.notice.c_str());
@@ -146,6 +160,37 @@ void Hud::connection(const HudView& v) {
   ImGui::End();
 }
 
+void Hud::live_plots(const HudView& v) {
+  LivePlots& plots = *v.plots;
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  ImGui::SetNextWindowPos({vp->WorkPos.x + vp->WorkSize.x - 12.0f, 12.0f}, ImGuiCond_Always, {1.0f, 0.0f});
+  ImGui::SetNextWindowBgAlpha(0.55f);
+  ImGui::Begin("plots", nullptr,
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                   ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoMove);
+  ImGui::TextColored(kDim, "Last %.0f s", plots.span_seconds());
+  struct Plot {
+    LivePlots::Series series;
+    const char* format;  // of the newest value
+  };
+  static constexpr Plot kPlots[] = {{LivePlots::kinetic_energy, "kinetic energy %.3g J/ball"},
+                                    {LivePlots::contacts, "contacts %.0f"},
+                                    {LivePlots::steps_per_s, "steps/s %.0f"},
+                                    {LivePlots::time_scale, "time scale %.2f"}};
+  for (const Plot& p : kPlots) {
+    char label[64];
+    std::snprintf(label, sizeof label, p.format, plots.newest(p.series));
+    const std::vector<float>& values = plots.series(p.series);
+    ImGui::TextUnformatted(label);
+    ImGui::PushID(p.series);
+    // From zero up, so a plot's height compares with its own past.
+    ImGui::PlotLines("", values.data(), static_cast<int>(values.size()), 0, nullptr, 0.0f, FLT_MAX,
+                     {300.0f, 48.0f});
+    ImGui::PopID();
+  }
+  ImGui::End();
+}
+
 void Hud::help() {
   const ImGuiViewport* vp = ImGui::GetMainViewport();
   ImGui::SetNextWindowPos({vp->WorkPos.x + vp->WorkSize.x * 0.5f, vp->WorkPos.y + vp->WorkSize.y * 0.5f},
@@ -161,6 +206,14 @@ void Hud::help() {
       {"Left-drag", "orbit the camera around the tank"},
       {"Wheel", "zoom in / out"},
       {"B", "pour 1000 more balls in from the top"},
+      {"P", "pause / resume the simulation (for everyone)"},
+      {"O", "one step (pauses first)"},
+      {"R", "reset: the scene from its start"},
+      {"[ / ]", "time scale slower / faster: 0.1, 0.25, 0.5, 1"},
+      {"1 2 3 4", "scene: tank, wide, dam-break, drop"},
+      {"", "(P O R [ ] 1-4 as the server's --control allows: see Control)"},
+      {"F12", "save a screenshot (PNG) in the working folder"},
+      {"F2", "show / hide the live plots"},
       {"T", "show / hide the tank's edges"},
       {"F1", "show / hide the statistics"},
       {"F11", "full screen on / off"},

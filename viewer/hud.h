@@ -1,10 +1,13 @@
 #pragma once
 // The heads-up display, drawn with Dear ImGui over the scene: measured frame
 // and physics rates, the server's build, network figures, the connection's
-// state, and the help overlay with every control.
+// state, the sandbox's state (scene, paused, time scale, who may control),
+// live plots of the last 30 s, and the help overlay with every control.
 
 #include <cstdint>
+#include <string>
 
+#include "viewer/live_plots.h"
 #include "viewer/net/client.h"
 
 struct GLFWwindow;
@@ -21,6 +24,10 @@ struct HudView {
   bool observer = false;
   bool show_stats = true;
   bool show_help = false;
+  bool show_plots = true;
+  LivePlots* plots = nullptr;
+  std::string viewer_notice;  // the viewer's own news (a screenshot saved), shown for a few seconds
+  double viewer_notice_time = -1.0;
   double now = 0.0;
 };
 
@@ -38,6 +45,7 @@ class Hud {
   void stats(const HudView& v);
   void connection(const HudView& v);
   void help();
+  void live_plots(const HudView& v);
 };
 
 }  // namespace fishtank::viewer

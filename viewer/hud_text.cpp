@@ -26,12 +26,24 @@ std::string threads_text(std::uint32_t stepping, int available) {
   return text;
 }
 
-std::string time_scale_text(float time_scale) {
+std::string time_scale_text(float time_scale, float time_scale_set, bool paused) {
+  if (paused) return "paused";
   if (!(time_scale > 0.0f)) return "-";
-  if (!slow_motion(time_scale)) return "real time";
-  char text[40];
-  std::snprintf(text, sizeof text, "slow motion \u00d7%.2f", time_scale);
+  const float set = time_scale_set > 0.0f ? time_scale_set : 1.0f;
+  const bool slowed = set < kSlowMotionBelow;
+  char text[64];
+  if (slow_motion(time_scale, set)) {
+    const int n = std::snprintf(text, sizeof text, "slow motion \u00d7%.2f", time_scale);
+    if (slowed) std::snprintf(text + n, sizeof text - n, " (\u00d7%.2f set)", set);
+    return text;
+  }
+  if (!slowed) return "real time";
+  std::snprintf(text, sizeof text, "\u00d7%.2f as set", set);
   return text;
+}
+
+std::string control_text(bool may_control, const std::string& policy) {
+  return (may_control ? "yours (P O R [ ] 1-4): " : "not yours: ") + policy;
 }
 
 }  // namespace fishtank::viewer

@@ -20,7 +20,13 @@ Freshness figures_freshness(bool connected, double now, double last_update);
 // "stepping on 1 of 2 threads"; "2 threads at most" when the server did not say.
 std::string threads_text(std::uint32_t stepping, int available);
 
-// "real time", "slow motion ×0.42", or "-" when the server did not say.
-std::string time_scale_text(float time_scale);
+// How fast simulated time runs: "paused"; "real time"; "×0.50 as set" when
+// people slowed it; "slow motion ×0.42" (with "(×0.50 set)" when slowed too)
+// when the physics cannot keep the pace asked for; "-" when the server did
+// not say. time_scale_set 0 (not reported) counts as 1.
+std::string time_scale_text(float time_scale, float time_scale_set = 1.0f, bool paused = false);
+
+// Who may use the sandbox's controls, for the HUD: this viewer's part first.
+std::string control_text(bool may_control, const std::string& policy);
 
 }  // namespace fishtank::viewer

@@ -31,8 +31,35 @@ void Input::on_key(GLFWwindow* window, int key, int, int action, int) {
     case GLFW_KEY_F11:
       a.toggle_fullscreen = true;
       break;
+    case GLFW_KEY_F2:
+      a.toggle_plots = true;
+      break;
+    case GLFW_KEY_F12:
+      a.screenshot = true;
+      break;
     case GLFW_KEY_ESCAPE:
       a.quit = true;
+      break;
+    case GLFW_KEY_P:
+      a.sandbox.toggle_pause = true;
+      break;
+    case GLFW_KEY_O:
+      a.sandbox.single_step = true;
+      break;
+    case GLFW_KEY_R:
+      a.sandbox.reset = true;
+      break;
+    case GLFW_KEY_LEFT_BRACKET:
+      a.sandbox.time_scale_change = -1;
+      break;
+    case GLFW_KEY_RIGHT_BRACKET:
+      a.sandbox.time_scale_change = +1;
+      break;
+    case GLFW_KEY_1:
+    case GLFW_KEY_2:
+    case GLFW_KEY_3:
+    case GLFW_KEY_4:
+      a.sandbox.scene = key - GLFW_KEY_1;
       break;
     default:
       break;

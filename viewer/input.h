@@ -4,6 +4,7 @@
 // falls on the HUD belongs to Dear ImGui.
 
 #include "viewer/render/camera.h"
+#include "viewer/sandbox_controls.h"
 
 struct GLFWwindow;
 
@@ -16,7 +17,10 @@ struct Actions {
   bool toggle_hud = false;         // F1
   bool add_balls = false;          // B
   bool toggle_fullscreen = false;  // F11
+  bool toggle_plots = false;       // F2
+  bool screenshot = false;         // F12
   bool quit = false;               // Esc
+  SandboxKeys sandbox;             // P, O, R, [, ], 1-4
 };
 
 class Input {

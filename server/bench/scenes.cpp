@@ -1,52 +1,10 @@
 #include "server/bench/scenes.h"
 
+#include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
-#include <random>
 
 namespace fishtank {
-
-namespace {
-constexpr float kLatticeSpacing = kMaxBallDiameter + 0.05f;
-constexpr float kTankHeight = 40.0f;
-
-int wide_lattice_side(std::uint32_t balls) {
-  const int layers = static_cast<int>(kTankHeight / kLatticeSpacing);
-  return std::max(2, static_cast<int>(std::ceil(std::sqrt(double(balls) / layers))));
-}
-}  // namespace
-
-bool is_known_scene(const std::string& name) { return name == "tank" || name == "wide"; }
-
-TankBounds scene_tank(const SceneSpec& spec) {
-  TankBounds tank;
-  if (spec.name == "wide") {
-    float half = 0.5f * wide_lattice_side(spec.balls) * kLatticeSpacing;
-    tank.min = {-half, 0.0f, -half};
-    tank.max = {half, kTankHeight, half};
-  }
-  return tank;
-}
-
-std::string populate(World& world, const SceneSpec& spec) {
-  if (spec.name == "tank") {
-    AddResult added = world.add_balls(spec.balls);
-    return added.refusal;
-  }
-  // wide: a loose lattice, layer by layer from the floor, kinds taking turns.
-  const int side = wide_lattice_side(spec.balls);
-  const TankBounds& t = world.params().tank;
-  std::mt19937_64 rng(spec.seed);
-  auto jitter = [&rng] { return static_cast<float>(rng() >> 40) * (1.0f / 16777216.0f) - 0.5f; };
-  for (std::uint32_t b = 0; b < spec.balls; ++b) {
-    std::uint32_t layer = b / (side * side), cell = b % (side * side);
-    Vec3 p{t.min.x + (cell % side + 0.5f) * kLatticeSpacing, t.min.y + (layer + 0.5f) * kLatticeSpacing,
-           t.min.z + (cell / side + 0.5f) * kLatticeSpacing};
-    world.place_ball(static_cast<int>(b % kKindCount), p, Vec3{jitter(), jitter(), jitter()});
-  }
-  return "";
-}
 
 SettleReport settle(World& world, const SceneSpec& spec) {
   const double limit = spec.max_settle_seconds > 0.0 ? spec.max_settle_seconds : (spec.name == "wide" ? 4.0 : 90.0);

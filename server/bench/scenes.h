@@ -2,25 +2,14 @@
 // Named benchmark scenes, each built and brought to rest the same way for
 // every variant, so their timings compare like with like.
 //
-//   tank  the product's 40-unit tank; N balls pour in from the top.
-//   wide  the same height, widened so N balls dropped from a loose lattice
-//         settle into a layer about a third of the height: cost per
-//         ball-step should not grow with N.
+// The scenes themselves are server/scenes/scene_presets.h, shared with the
+// interactive server.
 
 #include <cstdint>
-#include <memory>
-#include <string>
 
-#include "server/physics/world.h"
+#include "server/scenes/scene_presets.h"
 
 namespace fishtank {
-
-struct SceneSpec {
-  std::string name = "tank";
-  std::uint32_t balls = 6000;
-  std::uint64_t seed = 1;
-  double max_settle_seconds = 0.0;  // simulated; 0 means the scene's default
-};
 
 struct SettleReport {
   bool settled = false;
@@ -29,11 +18,6 @@ struct SettleReport {
   std::uint64_t steps = 0;
 };
 
-bool is_known_scene(const std::string& name);
-// Tank bounds the scene needs for this many balls.
-TankBounds scene_tank(const SceneSpec& spec);
-// Puts the scene's balls in (queued or placed); returns a refusal message or "".
-std::string populate(World& world, const SceneSpec& spec);
 // Steps until every ball is in and the mean kinetic energy per ball is below
 // kRestEnergy, or the time limit passes. Prints progress on stderr.
 SettleReport settle(World& world, const SceneSpec& spec);

@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "common/scene_names.h"
+
 namespace fishtank::net {
 
 Outcome ClientProtocol::refuse(wire::ErrorCode code, const std::string& why, bool disconnect) {
@@ -81,9 +83,48 @@ Outcome ClientProtocol::on_message(const wire::Message& message) {
     case wire::Payload::Ping:
       out.replies.push_back(protocol::encode_pong(message.payload_as_Ping()->client_time_us()));
       return out;
+    case wire::Payload::Pause:
+    case wire::Payload::Step:
+    case wire::Payload::Reset:
+    case wire::Payload::SetTimeScale:
+      return on_control(message);
     default:  // decode_frame accepts nothing else in this direction
       return refuse(wire::ErrorCode::unexpected_message, "message type not accepted by the server", false);
   }
+}
+
+Outcome ClientProtocol::on_control(const wire::Message& message) {
+  if (!may_control(info_.control, has_player_))
+    return refuse(wire::ErrorCode::not_permitted,
+                  std::string(wire::EnumNamePayload(message.payload_type())) + " refused: " + describe(info_.control),
+                  /*disconnect=*/false);
+  Outcome out;
+  switch (message.payload_type()) {
+    case wire::Payload::Pause:
+      out.command = Command{client_id_, PauseCommand{message.payload_as_Pause()->paused()}};
+      break;
+    case wire::Payload::Step:
+      out.command = Command{client_id_, StepCommand{message.payload_as_Step()->count()}};
+      break;
+    case wire::Payload::Reset: {
+      const wire::Reset& r = *message.payload_as_Reset();
+      ResetCommand reset;
+      if (r.scene()) {
+        reset.scene = r.scene()->str();
+        if (!is_scene_name(*reset.scene))
+          return refuse(wire::ErrorCode::invalid_value,
+                        "unknown scene '" + printable_name(*reset.scene) + "'; the scenes are " + scene_names_text(),
+                        /*disconnect=*/false);
+      }
+      if (r.seed()) reset.seed = *r.seed();
+      out.command = Command{client_id_, std::move(reset)};
+      break;
+    }
+    default:  // SetTimeScale: decode_frame checked its range
+      out.command = Command{client_id_, TimeScaleCommand{message.payload_as_SetTimeScale()->scale()}};
+      break;
+  }
+  return out;
 }
 
 Outcome ClientProtocol::on_reply(const Reply& reply) {
@@ -98,6 +139,9 @@ Outcome ClientProtocol::on_reply(const Reply& reply) {
     w.dt = info_.dt;
     w.player_id = joined->player_id;
     w.snapshot_rate_hz = info_.snapshot_rate_hz;
+    has_player_ = joined->player_id.has_value();
+    w.control_policy = describe(info_.control);
+    w.may_control = may_control(info_.control, has_player_);
     out.replies.push_back(protocol::encode_welcome(w));
     if (!joined->refusal.empty())
       out.replies.push_back(protocol::encode_error(wire::ErrorCode::player_limit, joined->refusal));
@@ -106,6 +150,13 @@ Outcome ClientProtocol::on_reply(const Reply& reply) {
                   : "welcomed as observer" + (joined->refusal.empty() ? "" : " (" + joined->refusal + ")");
     state_ = State::active;
     return out;
+  }
+  if (const auto* control = std::get_if<ControlRefusedReply>(&reply.result)) {
+    using Why = ControlRefusedReply::Why;
+    const wire::ErrorCode code = control->why == Why::not_paused    ? wire::ErrorCode::not_paused
+                                 : control->why == Why::fewer_balls ? wire::ErrorCode::tank_full
+                                                                    : wire::ErrorCode::server_busy;
+    return refuse(code, control->refusal, /*disconnect=*/false);
   }
   const auto& added = std::get<BallsAddedReply>(reply.result);
   if (added.refusal.empty()) return out;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "protocol/frame_codec.h"
+#include "server/control_policy.h"
 #include "server/net/commands.h"
 
 namespace fishtank::net {
@@ -24,6 +25,7 @@ struct ServerInfo {
   TankBounds tank;
   float dt = 0.0f;
   float snapshot_rate_hz = 60.0f;
+  ControlPolicy control = ControlPolicy::players;
 };
 
 struct Outcome {
@@ -60,11 +62,14 @@ class ClientProtocol {
   Outcome on_hello(const wire::Hello& hello);
   Outcome on_message(const wire::Message& message);
   Outcome refuse(wire::ErrorCode code, const std::string& why, bool disconnect);
+  // Pause, Step, Reset, SetTimeScale: allowed by the policy, values the server knows.
+  Outcome on_control(const wire::Message& message);
 
   std::uint32_t client_id_;
   const ServerInfo& info_;
   State state_ = State::awaiting_hello;
   std::string name_;
+  bool has_player_ = false;
 };
 
 }  // namespace fishtank::net

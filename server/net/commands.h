@@ -29,9 +29,27 @@ struct AddBallsCommand {
   std::uint32_t count = 0;
 };
 
+// The sandbox's controls; the session has already checked the client may
+// (ControlPolicy) and that the values are in range.
+struct PauseCommand {
+  bool paused = true;
+};
+struct StepCommand {
+  std::uint32_t count = 0;
+};
+struct ResetCommand {
+  std::optional<std::string> scene;   // empty: the scene running
+  std::optional<std::uint64_t> seed;  // empty: the scene's last seed
+};
+struct TimeScaleCommand {
+  float scale = 1.0f;
+};
+
 struct Command {
   std::uint32_t client_id = 0;
-  std::variant<JoinCommand, LeaveCommand, SetVelocityCommand, AddBallsCommand> action;
+  std::variant<JoinCommand, LeaveCommand, SetVelocityCommand, AddBallsCommand, PauseCommand, StepCommand, ResetCommand,
+               TimeScaleCommand>
+      action;
 };
 
 struct JoinedReply {
@@ -42,9 +60,21 @@ struct BallsAddedReply {
   std::string refusal;  // empty when all were accepted; else how many were and why no more
 };
 
+// A control the physics thread could not fully carry out, and why; nothing is
+// sent when it was done.
+struct ControlRefusedReply {
+  enum class Why {
+    not_paused,   // a Step while running: nothing done
+    fewer_balls,  // the scene started with fewer balls than asked
+    too_soon      // a Reset before the last one's spacing was up: nothing done
+  };
+  Why why = Why::not_paused;
+  std::string refusal;
+};
+
 struct Reply {
   std::uint32_t client_id = 0;
-  std::variant<JoinedReply, BallsAddedReply> result;
+  std::variant<JoinedReply, BallsAddedReply, ControlRefusedReply> result;
 };
 
 // Bounded, so a client flooding commands faster than the physics drains them

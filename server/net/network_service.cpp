@@ -22,13 +22,15 @@ double thread_cpu_seconds(std::thread& thread) {
 
 }  // namespace
 
-NetworkService::NetworkService(const NetOptions& options, ServerInfo info, std::atomic<bool>& stop)
+NetworkService::NetworkService(const NetOptions& options, ServerInfo info, RunControl& control, ActiveScene& scene,
+                               std::atomic<bool>& stop)
     : options_(options),
       work_(boost::asio::make_work_guard(io_)),
       signals_(io_, SIGINT, SIGTERM),
       server_(io_, std::move(info), commands_),
       link_(
-          commands_, server_.viewers(), options.link, [this](Reply reply) { server_.post_reply(std::move(reply)); },
+          commands_, server_.viewers(), options.link, control, scene,
+          [this](Reply reply) { server_.post_reply(std::move(reply)); },
           [this](SharedSnapshot snapshot) { server_.post_snapshot(std::move(snapshot)); }) {
   signals_.async_wait([&stop](boost::system::error_code ec, int) {
     if (!ec) stop = true;

@@ -30,8 +30,10 @@ struct NetOptions {
 
 class NetworkService {
  public:
-  // stop is set by SIGINT or SIGTERM.
-  NetworkService(const NetOptions& options, ServerInfo info, std::atomic<bool>& stop);
+  // stop is set by SIGINT or SIGTERM. control and scene are the physics
+  // thread's, changed by clients' commands at step boundaries.
+  NetworkService(const NetOptions& options, ServerInfo info, RunControl& control, ActiveScene& scene,
+                 std::atomic<bool>& stop);
   // Stops the io thread; call after the physics loop has returned.
   ~NetworkService();
 

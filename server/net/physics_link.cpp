@@ -14,12 +14,25 @@ Overloaded(Ts...) -> Overloaded<Ts...>;
 }  // namespace
 
 PhysicsLink::PhysicsLink(CommandQueue& queue, const std::atomic<int>& viewers, PhysicsLinkOptions options,
-                         std::function<void(Reply)> reply, std::function<void(SharedSnapshot)> publish)
-    : queue_(queue), viewers_(viewers), options_(options), reply_(std::move(reply)), publish_(std::move(publish)) {}
+                         RunControl& control, ActiveScene& scene, std::function<void(Reply)> reply,
+                         std::function<void(SharedSnapshot)> publish)
+    : queue_(queue),
+      viewers_(viewers),
+      options_(options),
+      control_(control),
+      scene_(scene),
+      reply_(std::move(reply)),
+      publish_(std::move(publish)) {}
 
 void PhysicsLink::at_step_boundary(World& world, const LoopStatus& status) {
   queue_.drain(drained_);
-  for (const Command& command : drained_) apply(world, command);
+  // A reset replaces everything before it, so of a burst only the last is
+  // carried out: a client repeating Reset cannot stall the physics for all.
+  std::size_t last_reset = drained_.size();
+  for (std::size_t i = 0; i < drained_.size(); ++i)
+    if (std::holds_alternative<ResetCommand>(drained_[i].action)) last_reset = i;
+  for (std::size_t i = 0; i < drained_.size(); ++i)
+    if (i == last_reset || !std::holds_alternative<ResetCommand>(drained_[i].action)) apply(world, drained_[i]);
 
   const Clock::time_point now = Clock::now();
   if (now < next_snapshot_) return;
@@ -61,8 +74,46 @@ void PhysicsLink::apply(World& world, const Command& command) {
                    AddResult added = world.add_balls(add.count);
                    reply_({client, BallsAddedReply{std::move(added.refusal)}});
                  },
+                 [&](const PauseCommand& pause) {
+                   control_.paused = pause.paused;
+                   if (!pause.paused) control_.steps_to_run = 0;
+                 },
+                 [&](const StepCommand& step) {
+                   if (control_.paused)
+                     control_.steps_to_run += step.count;
+                   else
+                     reply_({client, ControlRefusedReply{ControlRefusedReply::Why::not_paused,
+                                                         "Step works only while paused; pause first"}});
+                 },
+                 [&](const ResetCommand& reset) {
+                   const Clock::time_point start = Clock::now();
+                   if (start < next_reset_) {
+                     reply_({client, ControlRefusedReply{ControlRefusedReply::Why::too_soon,
+                                                         "Reset refused: it came too soon after the last one "
+                                                         "(restarts may take a fifth of the physics at most); "
+                                                         "try again"}});
+                     return;
+                   }
+                   // Asked-for steps belonged to the old start; a pause holds the new one still.
+                   control_.steps_to_run = 0;
+                   std::string refusal = scene_.start(world, reset.scene, reset.seed);
+                   const Clock::time_point end = Clock::now();
+                   next_reset_ = end + kResetSpacing * (end - start);
+                   if (!refusal.empty())
+                     reply_({client, ControlRefusedReply{ControlRefusedReply::Why::fewer_balls, std::move(refusal)}});
+                 },
+                 [&](const TimeScaleCommand& scale) { control_.time_scale = scale.scale; },
              },
              command.action);
+}
+
+void PhysicsLink::refresh_figures(const World& world, Clock::time_point now) {
+  if (now < next_figures_ && figures_start_ == scene_.start_count()) return;
+  next_figures_ = now + kFiguresPeriod;
+  figures_start_ = scene_.start_count();
+  kinetic_energy_per_ball_ =
+      world.ball_count() ? static_cast<float>(world.kinetic_energy() / world.ball_count()) : 0.0f;
+  contacts_ = world.contact_count();
 }
 
 void PhysicsLink::publish_snapshot(const World& world, const LoopStatus& status) {
@@ -75,6 +126,14 @@ void PhysicsLink::publish_snapshot(const World& world, const LoopStatus& status)
   header.load = static_cast<float>(status.load);
   header.threads_stepping = static_cast<std::uint32_t>(status.threads);
   header.time_scale = static_cast<float>(status.time_scale);
+  header.paused = control_.paused;
+  header.time_scale_set = static_cast<float>(control_.time_scale);
+  header.scene = scene_.name();
+  header.scene_start = scene_.start_count();
+  header.tank = world.params().tank;
+  refresh_figures(world, start);
+  header.kinetic_energy_per_ball = kinetic_energy_per_ball_;
+  header.contacts = contacts_;
   SharedSnapshot snapshot = encoder_.encode(world, header);
   stats_.last_frame_bytes = snapshot->frame->size();
   stats_.encode_seconds += std::chrono::duration<double>(Clock::now() - start).count();

@@ -1,8 +1,9 @@
 #pragma once
 // The network's agent on the physics thread. Called by the realtime loop at
 // every step boundary, it
-//   1. applies the commands the sessions queued (join, leave, velocity, add balls)
-//      and hands each answer back to the io thread;
+//   1. applies the commands the sessions queued (join, leave, velocity, add balls,
+//      and the sandbox's pause, step, reset and time scale) and hands each
+//      answer back to the io thread;
 //   2. encodes a snapshot when one is due (--snapshot-rate) and someone watches.
 // Nothing here runs on the io thread, so the world needs no lock.
 
@@ -16,6 +17,7 @@
 #include "server/net/commands.h"
 #include "server/net/snapshot_encoder.h"
 #include "server/realtime_loop.h"
+#include "server/scenes/active_scene.h"
 
 namespace fishtank::net {
 
@@ -35,8 +37,9 @@ class PhysicsLink {
  public:
   // reply and publish are called on the physics thread and must only hand
   // their argument over to the io thread (post), never block.
-  PhysicsLink(CommandQueue& queue, const std::atomic<int>& viewers, PhysicsLinkOptions options,
-              std::function<void(Reply)> reply, std::function<void(SharedSnapshot)> publish);
+  // control and scene belong to the physics thread too; they outlive this link.
+  PhysicsLink(CommandQueue& queue, const std::atomic<int>& viewers, PhysicsLinkOptions options, RunControl& control,
+              ActiveScene& scene, std::function<void(Reply)> reply, std::function<void(SharedSnapshot)> publish);
 
   void at_step_boundary(World& world, const LoopStatus& status);
   const SnapshotStats& snapshot_stats() const { return stats_; }
@@ -46,10 +49,21 @@ class PhysicsLink {
 
   void apply(World& world, const Command& command);
   void publish_snapshot(const World& world, const LoopStatus& status);
+  // Refreshes the plotted figures (energy, contacts) when they are older than kFiguresPeriod.
+  void refresh_figures(const World& world, Clock::time_point now);
+  // The figures pass over every ball and contact: ten times a second is
+  // plenty for a plot, and keeps a large scene's snapshots cheap.
+  static constexpr std::chrono::milliseconds kFiguresPeriod{100};
+  // A restart costs what filling its scene costs; the next may come only
+  // after this many times that, so however often clients ask, restarts take
+  // at most a fifth of the physics thread.
+  static constexpr int kResetSpacing = 4;
 
   CommandQueue& queue_;
   const std::atomic<int>& viewers_;
   PhysicsLinkOptions options_;
+  RunControl& control_;
+  ActiveScene& scene_;
   std::function<void(Reply)> reply_;
   std::function<void(SharedSnapshot)> publish_;
 
@@ -59,6 +73,11 @@ class PhysicsLink {
   std::uint32_t tick_ = 0;
   Clock::time_point next_snapshot_ = Clock::now();
   SnapshotStats stats_;
+  Clock::time_point next_figures_ = Clock::now();
+  std::uint32_t figures_start_ = 0;  // the scene start they were measured in
+  float kinetic_energy_per_ball_ = 0.0f;
+  std::uint32_t contacts_ = 0;
+  Clock::time_point next_reset_ = Clock::time_point::min();
 };
 
 }  // namespace fishtank::net

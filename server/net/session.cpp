@@ -79,6 +79,10 @@ void Session::do_write() {
     writing_snapshot_ = std::move(newest_snapshot_);
     newest_snapshot_.reset();
     const std::uint32_t balls = writing_snapshot_->ball_count;
+    if (writing_snapshot_->scene_start != scene_start_) {
+      scene_start_ = writing_snapshot_->scene_start;
+      kinds_sent_ = 0;  // new balls, new ids from 0
+    }
     if (balls > kinds_sent_) {
       writing_kinds_ = protocol::encode_ball_kinds(kinds_sent_, writing_snapshot_->kinds_by_id->data() + kinds_sent_,
                                                    balls - kinds_sent_);

@@ -69,6 +69,7 @@ class Session : public std::enable_shared_from_this<Session> {
   std::deque<protocol::Frame> replies_;
   SharedSnapshot newest_snapshot_;  // waiting to be sent; replaced, never queued
   std::uint32_t kinds_sent_ = 0;    // balls whose kinds this client has been sent
+  std::uint32_t scene_start_ = 0;   // of the last snapshot sent: kinds_sent_ counts from that start
 
   // Kept alive while the write is in flight.
   std::vector<protocol::Frame> writing_replies_;

@@ -4,8 +4,12 @@
 
 namespace fishtank::net {
 
-void SnapshotEncoder::extend_kinds(const World& world) {
+void SnapshotEncoder::extend_kinds(const World& world, std::uint32_t scene_start) {
   const std::uint32_t n = world.ball_count();
+  if (scene_start != scene_start_) {
+    scene_start_ = scene_start;
+    kinds_by_id_ = std::make_shared<std::vector<std::uint8_t>>();
+  }
   if (kinds_by_id_->size() >= n) return;
   // Copy-on-grow: sessions may still hold the old table, so it is never modified.
   auto grown = std::make_shared<std::vector<std::uint8_t>>(*kinds_by_id_);
@@ -20,7 +24,7 @@ void SnapshotEncoder::extend_kinds(const World& world) {
 
 SharedSnapshot SnapshotEncoder::encode(const World& world, const protocol::SnapshotHeader& header) {
   const std::uint32_t n = world.ball_count();
-  const TankBounds& tank = world.params().tank;
+  const TankBounds& tank = header.tank;
   quantised_.resize(3 * std::size_t{n});
   const Float4* pos = world.positions();
   const std::uint32_t* ids = world.ids();
@@ -37,12 +41,13 @@ SharedSnapshot SnapshotEncoder::encode(const World& world, const protocol::Snaps
     player_positions_[p] = {q.x, q.y, q.z};
   }
 
-  extend_kinds(world);
+  extend_kinds(world, header.scene_start);
   auto published = std::make_shared<PublishedSnapshot>();
   published->frame = std::make_shared<const protocol::Frame>(
       protocol::encode_snapshot(header, quantised_.data(), n, player_ids_.data(), player_positions_.data(), players));
   published->kinds_by_id = kinds_by_id_;
   published->ball_count = n;
+  published->scene_start = header.scene_start;
   return published;
 }
 

@@ -29,6 +29,10 @@ class PhaseTimer {
   std::chrono::steady_clock::time_point start_;
 };
 
+std::uint32_t capacity_of(const TankBounds& tank) {
+  return static_cast<std::uint32_t>(kPackingLimit * tank.volume() / mean_ball_volume());
+}
+
 double ball_energy(const Float4& pos, const Float4& vel, float gravity) {
   const double speed2 = double(vel.x) * vel.x + double(vel.y) * vel.y + double(vel.z) * vel.z;
   return 0.5 * vel.w * speed2 + double(vel.w) * gravity * pos.y;
@@ -44,7 +48,7 @@ World::World(const PhysicsParams& params, const Kernels& kernels, int threads, s
       spawner_(params.tank, seed) {
   enable_flush_denormals_to_zero();
   list_.configure(params.tank, params.skin);
-  capacity_ = static_cast<std::uint32_t>(kPackingLimit * params.tank.volume() / mean_ball_volume());
+  capacity_ = capacity_of(params.tank);
   max_balls_ = capacity_;
   chunk_moved_.resize(pool_.max_chunks());
   chunk_missing_.resize(pool_.max_chunks());
@@ -98,6 +102,33 @@ void World::place_ball(int kind, Vec3 p, Vec3 v) {
   energy_added_ += ball_energy(pos_[i], vel_[i], model_.gravity);
   needs_rebuild_ = true;
   needs_initial_forces_ = true;
+}
+
+void World::restart(const TankBounds& tank, std::uint64_t seed) {
+  params_.tank = tank;
+  model_.tank = tank;
+  list_.configure(tank, params_.skin);
+  spawner_ = Spawner(tank, seed);
+  capacity_ = capacity_of(tank);
+  max_balls_ = capacity_;
+  resize(0);
+  next_id_ = 0;
+  energy_added_ = 0.0;
+  vel_stale_ = false;
+  far_listed_ = false;
+  needs_initial_forces_ = false;
+  needs_rebuild_ = true;
+}
+
+void World::respawn_players() {
+  derive_velocities();
+  for (std::size_t p = 0; p < player_pos_.size(); ++p) {
+    // Avoids the players placed before it in this loop, not the old places of the others.
+    const Vec3 at = choose_player_spawn(params_.tank, player_pos_.data(), p, pos_.data(), n_);
+    player_pos_[p] = {at.x, at.y, at.z, 0.5f * kPlayerDiameter};
+    player_vel_[p] = {};
+  }
+  if (n_ > 0) needs_initial_forces_ = true;  // a ball a player now touches feels it from the next step's first kick
 }
 
 std::uint32_t World::add_player() {
@@ -457,6 +488,27 @@ double World::elastic_energy() const {
       if (overlap > 0.0) sum_x2 += overlap * overlap;
   }
   return 0.5 * model_.k * sum_x2;
+}
+
+std::uint32_t World::contact_count() const {
+  if (needs_rebuild_) return 0;  // no lists yet: nothing has been stepped
+  const TankBounds& t = params_.tank;
+  std::uint32_t sides = 0;  // each pair is listed from both sides
+  list_.for_each_list([&](std::uint32_t i, ListView list) {
+    const Float4& p = pos_[i];
+    for (std::uint32_t n = 0; n < list.count; ++n) {
+      const Float4& q = pos_[list[n]];
+      float dx = p.x - q.x, dy = p.y - q.y, dz = p.z - q.z, reach = p.w + q.w;
+      sides += dx * dx + dy * dy + dz * dz < reach * reach;
+    }
+  });
+  std::uint32_t walls = 0;
+  for (std::uint32_t i = 0; i < n_; ++i) {
+    const Float4& p = pos_[i];
+    walls += (p.x - p.w < t.min.x) + (p.x + p.w > t.max.x) + (p.y - p.w < t.min.y) + (p.y + p.w > t.max.y) +
+             (p.z - p.w < t.min.z) + (p.z + p.w > t.max.z);
+  }
+  return sides / 2 + walls;
 }
 
 float World::max_overlap_fraction() const {

@@ -66,6 +66,13 @@ class World {
   // so the next step starts with a force pass.
   void place_ball(int kind, Vec3 pos, Vec3 vel);
   void set_max_balls(std::uint32_t max_balls) { max_balls_ = max_balls; }
+  // Empties the world into a (possibly different) tank, for a scene's start:
+  // no balls, nothing queued, spawning reseeded, max_balls() the new capacity.
+  // The clock and step count go on (viewers interpolate over them); players
+  // stay, until respawn_players() puts them back near the centre.
+  void restart(const TankBounds& tank, std::uint64_t seed);
+  // Each player at a free point near the centre of the balls now present, at rest.
+  void respawn_players();
 
   // Kinematic player spheres; ids are never reused. Each starts at a free point
   // near the centre, apart from the others (choose_player_spawn).
@@ -127,6 +134,8 @@ class World {
   double kinetic_energy() const;
   double potential_energy() const;  // gravity, relative to y = 0
   double elastic_energy() const;    // springs of every contact: sum of k x^2 / 2
+  // Overlapping ball pairs and ball-wall contacts (0 before the first step).
+  std::uint32_t contact_count() const;
   // Kinetic plus gravitational energy of every ball at the moment it appeared:
   // with no player moving, the world's total energy can never exceed it.
   double energy_added() const { return energy_added_; }

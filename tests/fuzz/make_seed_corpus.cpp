@@ -21,6 +21,8 @@ int main(int argc, char** argv) {
   welcome.simd_level = "sse4.1";
   welcome.dt = 0.000785f;
   welcome.player_id = 0;
+  welcome.control_policy = "clients with a player sphere may pause";
+  welcome.may_control = true;
   const std::uint16_t positions[9] = {0, 100, 65535, 32768, 0, 1, 2, 3, 4};
   const std::uint8_t kinds[3] = {0, 1, 2};
   const std::uint32_t player_ids[1] = {0};
@@ -28,6 +30,7 @@ int main(int argc, char** argv) {
   protocol::SnapshotHeader header;
   header.tick = 5;
   header.sim_time = 1.25;
+  header.scene = "tank";
 
   const std::vector<std::pair<std::string, protocol::Frame>> frames = {
       {"hello", protocol::encode_hello("seed", true)},
@@ -40,9 +43,13 @@ int main(int argc, char** argv) {
       {"snapshot", protocol::encode_snapshot(header, positions, 3, player_ids, players, 1)},
       {"error", protocol::encode_error(wire::ErrorCode::tank_full, "added 10 of 20 balls")},
       {"pong", protocol::encode_pong(123456)},
+      {"pause", protocol::encode_pause(true)},
+      {"step", protocol::encode_step(10)},
+      {"reset", protocol::encode_reset("drop", 3)},
+      {"set_time_scale", protocol::encode_set_time_scale(0.5f)},
   };
   protocol::Frame conversation{0};  // chunk byte 0: one byte at a time
-  for (const char* name : {"hello", "player_input", "add_balls", "ping"})
+  for (const char* name : {"hello", "player_input", "add_balls", "ping", "pause", "step", "reset", "set_time_scale"})
     for (const auto& [n, f] : frames)
       if (n == name) conversation.insert(conversation.end(), f.begin(), f.end());
 

@@ -40,6 +40,8 @@ TEST_CASE("every message survives encode then decode with its values intact", "[
     w.dt = 0.001f;
     w.player_id = 3;
     w.snapshot_rate_hz = 60.0f;
+    w.control_policy = "players may";
+    w.may_control = true;
     const protocol::Frame f = protocol::encode_welcome(w);
     const auto r = decode(f, Direction::to_client);
     REQUIRE(r.ok());
@@ -51,6 +53,8 @@ TEST_CASE("every message survives encode then decode with its values intact", "[
     REQUIRE(m.ball_kinds()->size() == kBallKinds.size());
     CHECK(m.ball_kinds()->Get(2)->diameter() == 3.0f);
     CHECK(m.tank_max()->y() == 40.0f);
+    CHECK(m.control_policy()->str() == "players may");
+    CHECK(m.may_control());
   }
   SECTION("Snapshot") {
     const std::vector<std::uint16_t> q{1, 2, 3, 65535, 0, 7};
@@ -61,6 +65,13 @@ TEST_CASE("every message survives encode then decode with its values intact", "[
     h.sim_time = 3.5;
     h.threads_stepping = 3;
     h.time_scale = 0.42f;
+    h.paused = true;
+    h.time_scale_set = 0.5f;
+    h.scene = "drop";
+    h.scene_start = 4;
+    h.tank.min = {-50.0f, 0.0f, -30.0f};
+    h.kinetic_energy_per_ball = 0.25f;
+    h.contacts = 1234;
     const protocol::Frame f = protocol::encode_snapshot(h, q.data(), 2, ids, players, 2);
     const auto r = decode(f, Direction::to_client);
     REQUIRE(r.ok());
@@ -69,9 +80,38 @@ TEST_CASE("every message survives encode then decode with its values intact", "[
     CHECK(s.sim_time() == 3.5);
     CHECK(s.threads_stepping() == 3);
     CHECK(s.time_scale() == 0.42f);
+    CHECK(s.paused());
+    CHECK(s.time_scale_set() == 0.5f);
+    CHECK(s.scene()->str() == "drop");
+    CHECK(s.scene_start() == 4);
+    CHECK(s.tank_min()->x() == -50.0f);
+    CHECK(s.tank_max()->x() == 20.0f);
+    CHECK(s.kinetic_energy_per_ball() == 0.25f);
+    CHECK(s.contacts() == 1234);
     CHECK(std::vector<std::uint16_t>(s.positions()->begin(), s.positions()->end()) == q);
     CHECK(s.player_ids()->Get(1) == 9);
     CHECK(s.player_positions()->Get(1)->z() == -6.0f);
+  }
+  SECTION("Pause, Step, Reset, SetTimeScale") {
+    const protocol::Frame resume = protocol::encode_pause(false);
+    const auto p = decode(resume, Direction::to_server);
+    REQUIRE(p.ok());
+    CHECK_FALSE(p.message->payload_as_Pause()->paused());
+    const protocol::Frame step = protocol::encode_step(25);
+    CHECK(decode(step, Direction::to_server).message->payload_as_Step()->count() == 25);
+    const protocol::Frame reset = protocol::encode_reset("wide", 9);
+    const auto r = decode(reset, Direction::to_server);
+    REQUIRE(r.ok());
+    CHECK(r.message->payload_as_Reset()->scene()->str() == "wide");
+    CHECK(r.message->payload_as_Reset()->seed().value() == 9);
+    // No scene and no seed: both absent, not an empty name and seed 0.
+    const protocol::Frame plain = protocol::encode_reset("", std::nullopt);
+    const auto same = decode(plain, Direction::to_server);
+    REQUIRE(same.ok());
+    CHECK(same.message->payload_as_Reset()->scene() == nullptr);
+    CHECK_FALSE(same.message->payload_as_Reset()->seed().has_value());
+    const protocol::Frame scale = protocol::encode_set_time_scale(0.25f);
+    CHECK(decode(scale, Direction::to_server).message->payload_as_SetTimeScale()->scale() == 0.25f);
   }
   SECTION("BallKinds, AddBalls, Ping, Pong, Error") {
     const std::uint8_t kinds[] = {0, 1, 2, 1};
@@ -137,6 +177,30 @@ TEST_CASE("frames a peer got wrong are refused with a status that says whether t
   SECTION("AddBalls outside 1 .. kMaxAddBallsPerRequest is an invalid value") {
     CHECK(decode(protocol::encode_add_balls(0), Direction::to_server).status == DecodeStatus::invalid_value);
     CHECK(decode(protocol::encode_add_balls(protocol::kMaxAddBallsPerRequest + 1), Direction::to_server).status ==
+          DecodeStatus::invalid_value);
+  }
+  SECTION("a time scale outside 0.1 .. 1 or NaN, a Step of 0 or too many, a long scene name are invalid values") {
+    for (float scale : {0.05f, 1.5f, -1.0f, std::nanf("")}) {
+      INFO(scale);
+      const auto r = decode(protocol::encode_set_time_scale(scale), Direction::to_server);
+      CHECK(r.status == DecodeStatus::invalid_value);
+      CHECK(r.why.find("between 0.1 and 1") != std::string::npos);
+    }
+    CHECK(decode(protocol::encode_set_time_scale(0.1f), Direction::to_server).ok());
+    CHECK(decode(protocol::encode_set_time_scale(1.0f), Direction::to_server).ok());
+    CHECK(decode(protocol::encode_step(0), Direction::to_server).status == DecodeStatus::invalid_value);
+    CHECK(decode(protocol::encode_step(protocol::kMaxStepsPerRequest + 1), Direction::to_server).status ==
+          DecodeStatus::invalid_value);
+    CHECK(decode(protocol::encode_reset(std::string(40, 'x'), std::nullopt), Direction::to_server).status ==
+          DecodeStatus::invalid_value);
+  }
+  SECTION("a snapshot whose tank is inside out is an invalid value") {
+    protocol::SnapshotHeader h;
+    h.tank.min = {30.0f, 0.0f, -20.0f};
+    const std::uint16_t q[3] = {};
+    const std::uint32_t id = 0;
+    const Vec3 player{};
+    CHECK(decode(protocol::encode_snapshot(h, q, 1, &id, &player, 1), Direction::to_client).status ==
           DecodeStatus::invalid_value);
   }
   SECTION("a server message sent to the server is refused as the wrong direction") {

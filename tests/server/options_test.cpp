@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "server/physics/worker_pool.h"
+#include "server/scenes/scene_presets.h"
 
 using namespace fishtank;
 
@@ -50,6 +51,7 @@ TEST_CASE("the help text (--help) lists every flag and exits 0 without starting 
                            "--port",
                            "--snapshot-rate",
                            "--max-players",
+                           "--control",
                            "--stiffness",
                            "--restitution",
                            "--steps-per-contact",
@@ -88,6 +90,24 @@ TEST_CASE("the wide benchmark's flags give its spec, and a tank widened for the 
   CHECK(parse({"--bench"}).options->start_balls == 6000);
 }
 
+TEST_CASE(
+    "an interactive scene starts with its own number of balls unless --balls says, and --control sets who may "
+    "use the sandbox's controls",
+    "[options]") {
+  const ParseResult drop = parse({"--scene", "drop"});
+  REQUIRE(drop.options);
+  CHECK(drop.options->bench_spec.scene.name == "drop");
+  CHECK(drop.options->start_balls == default_balls("drop"));
+  CHECK_FALSE(drop.options->balls_given);
+  CHECK(drop.options->control == ControlPolicy::players);
+  const ParseResult given = parse({"--scene", "dam-break", "--balls", "500", "--control", "everyone"});
+  REQUIRE(given.options);
+  CHECK(given.options->start_balls == 500);
+  CHECK(given.options->balls_given);
+  CHECK(given.options->control == ControlPolicy::everyone);
+  CHECK(parse({"--control", "nobody"}).options->control == ControlPolicy::nobody);
+}
+
 TEST_CASE("every bad value is refused with a message naming it and exit code 2", "[options]") {
   struct Bad {
     std::vector<std::string> args;
@@ -106,6 +126,8 @@ TEST_CASE("every bad value is refused with a message naming it and exit code 2",
       {{"--status-interval", "0"}, "--status-interval"},
       {{"--settle-time", "inf"}, "--settle-time"},
       {{"--bench", "--scene", "cube"}, "unknown scene 'cube'"},
+      {{"--scene", "cube"}, "unknown scene 'cube'; the scenes are tank, wide, dam-break and drop"},
+      {{"--control", "observers"}, "--control must be players, everyone or nobody"},
       {{"--port", "70000"}, "--port must be between"},
       {{"--snapshot-rate", "0"}, "--snapshot-rate"},
       {{"--max-players", "-1"}, "--max-players"},

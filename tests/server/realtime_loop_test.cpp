@@ -1,6 +1,9 @@
 // The paced loop keeps calling back between batches at the snapshot rate
 // whatever a step costs: a world far over its real-time budget runs in slow
-// motion and says so, and one within it keeps real time.
+// motion and says so, and one within it keeps real time. People's controls:
+// a paused loop steps only what is asked and keeps calling back, and a time
+// scale set below 1 slows simulated time by that much, without reading as
+// an overload.
 
 #include "server/realtime_loop.h"
 
@@ -9,6 +12,8 @@
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <vector>
+
+#include "common/time_scale.h"
 
 using namespace fishtank;
 
@@ -20,8 +25,9 @@ struct Observed {
   double sim_seconds = 0.0;
 };
 
-Observed run_paced(World& world, double seconds) {
+Observed run_paced(World& world, double seconds, RunControl* control = nullptr) {
   LoopOptions options;
+  options.control = control;
   options.duration = seconds;
   options.status_interval = 0.25;
   Observed seen;
@@ -77,4 +83,30 @@ TEST_CASE("a world within its budget keeps real time", "[server][loop]") {
   REQUIRE(seen.time_scales.size() >= 3);
   CHECK(seen.time_scales.back() == Approx(1.0).margin(0.1));
   CHECK(seen.sim_seconds == Approx(1.0).margin(0.1));
+}
+
+TEST_CASE("a paused loop runs exactly the steps asked for and keeps calling back at its rate", "[server][loop]") {
+  World world(with_stiffness(25000.0f), kSseKernels, 1, 5);
+  place_lattice(world, 100);
+  RunControl control;
+  control.paused = true;
+  control.steps_to_run = 37;
+  const Observed seen = run_paced(world, 0.5, &control);
+  CHECK(world.steps() == 37);
+  CHECK(control.steps_to_run == 0);
+  CHECK(seen.boundaries_per_s >= 30.0);  // snapshots and commands go on while paused
+}
+
+TEST_CASE("a time scale of one half advances half the simulated time, and is not called slow motion",
+          "[server][loop]") {
+  World world(with_stiffness(25000.0f), kSseKernels, 1, 5);
+  place_lattice(world, 100);
+  RunControl control;
+  control.time_scale = 0.5;
+  const Observed seen = run_paced(world, 1.0, &control);
+  CHECK(seen.sim_seconds == Approx(0.5).margin(0.06));
+  REQUIRE(seen.time_scales.size() >= 3);
+  CHECK(seen.time_scales.back() == Approx(0.5).margin(0.06));
+  CHECK_FALSE(slow_motion(seen.time_scales.back(), control.time_scale));
+  CHECK(slow_motion(seen.time_scales.back()));  // against real time it is slower
 }

@@ -44,3 +44,16 @@ TEST_CASE("the time scale reads real time at 1, slow motion with its factor belo
   CHECK(time_scale_text(0.05f) == "slow motion \u00d70.05");
   CHECK(time_scale_text(0.0f) == "-");
 }
+
+TEST_CASE("a time scale people set is not slow motion; a shortfall against it is, and paused says so") {
+  CHECK(time_scale_text(0.5f, 0.5f) == "\u00d70.50 as set");
+  CHECK(time_scale_text(0.49f, 0.5f) == "\u00d70.50 as set");  // jitter
+  CHECK(time_scale_text(0.30f, 0.5f) == "slow motion \u00d70.30 (\u00d70.50 set)");
+  CHECK(time_scale_text(1.0f, 0.0f) == "real time");  // a server that does not say runs at 1
+  CHECK(time_scale_text(0.0f, 1.0f, true) == "paused");
+}
+
+TEST_CASE("the control line says first whether this viewer may, then the server's policy") {
+  CHECK(control_text(true, "players may") == "yours (P O R [ ] 1-4): players may");
+  CHECK(control_text(false, "observers may not") == "not yours: observers may not");
+}

@@ -96,3 +96,14 @@ TEST_CASE("past the newest snapshot the frame holds it rather than guessing") {
   buffer.clear();
   CHECK_FALSE(buffer.frame_at(20.0, pair));
 }
+
+TEST_CASE("positions are dequantised over the snapshot's own tank, which follows the scene") {
+  auto a = snapshot(0.0, 0.0, 65535, 0.0f);
+  auto b = snapshot(0.1, 0.1, 65535, 0.0f);
+  for (auto* s : {a.get(), b.get()})
+    s->tank = {{-60.0f, 0.0f, -60.0f}, {60.0f, 40.0f, 60.0f}};  // a wide scene
+  std::vector<SphereInstance> out;
+  interpolate({a, b, 0.5f}, info_with_player(7), out);
+  CHECK(out[0].x == Approx(60.0f));
+  CHECK(out[0].z == Approx(60.0f));
+}

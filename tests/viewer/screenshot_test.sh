@@ -7,6 +7,7 @@
 # Usage: screenshot_test.sh SERVER VIEWER CHECKER OUT_DIR
 set -euo pipefail
 server=$1 viewer=$2 checker=$3 out=$4
+source "$(dirname "$0")/start_server.sh"
 
 if ! command -v xvfb-run >/dev/null; then
   echo "xvfb-run is not installed (scripts/install-deps viewer installs it): skipped"
@@ -17,22 +18,7 @@ png=$out/viewer_screenshot.png
 log=$out/server.log
 rm -f "$png"
 
-"$server" --port 0 --balls 1000 2>"$log" &
-server_pid=$!
-trap 'kill "$server_pid" 2>/dev/null || true; wait "$server_pid" 2>/dev/null || true' EXIT
-
-port=""
-for _ in $(seq 200); do
-  port=$(sed -n 's/^listening on .*:\([0-9][0-9]*\)$/\1/p' "$log")
-  [ -n "$port" ] && break
-  kill -0 "$server_pid" 2>/dev/null || break
-  sleep 0.05
-done
-if [ -z "$port" ]; then
-  echo "the server did not report its port:"
-  cat "$log"
-  exit 1
-fi
+start_server "$log" --balls 1000
 
 # Wait until every ball has been poured in and has had 4 s of server time to
 # fall (the server's status lines give both), so the pile lies below the

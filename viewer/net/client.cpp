@@ -56,6 +56,12 @@ void NetClient::add_balls(std::uint32_t count) {
   });
 }
 
+void NetClient::send_command(protocol::Frame frame) {
+  asio::post(io_, [this, frame = std::move(frame)]() mutable {
+    if (connected_) send(std::move(frame));
+  });
+}
+
 ConnectionStatus NetClient::status() const {
   std::lock_guard lock(status_mutex_);
   return status_;
@@ -199,6 +205,8 @@ void NetClient::on_welcome(const wire::Welcome& w) {
   info->client_id = w.client_id();
   info->has_player = w.has_player();
   info->player_id = w.player_id();
+  info->control_policy = w.control_policy() ? w.control_policy()->str() : "not stated by the server";
+  info->may_control = w.may_control();
   info_ = info;
   kinds_ = std::make_shared<std::vector<std::uint8_t>>();
   connected_ = true;
@@ -212,9 +220,11 @@ void NetClient::on_welcome(const wire::Welcome& w) {
 }
 
 void NetClient::on_ball_kinds(const wire::BallKinds& k) {
-  if (k.first_new_ball() != kinds_->size()) return lose("the server skipped or repeated ball kinds");
+  // Earlier than the kinds known: a scene started again and ids restart; later: a gap.
+  if (k.first_new_ball() > kinds_->size()) return lose("the server skipped ball kinds");
   // Copy on write: snapshots already handed to the render thread keep the old list.
-  auto kinds = std::make_shared<std::vector<std::uint8_t>>(*kinds_);
+  auto kinds =
+      std::make_shared<std::vector<std::uint8_t>>(kinds_->begin(), kinds_->begin() + k.first_new_ball());
   for (std::uint8_t kind : *k.kinds()) {
     if (kind >= info_->kinds.size())
       return lose("the server sent ball kind " + std::to_string(kind) + ", unknown");
@@ -233,12 +243,22 @@ void NetClient::on_snapshot(const wire::Snapshot& s) {
   snap->load = s.load();
   snap->threads_stepping = s.threads_stepping();
   snap->time_scale = s.time_scale();
+  snap->paused = s.paused();
+  snap->time_scale_set = s.time_scale_set();
+  snap->scene = s.scene() ? s.scene()->str() : std::string();
+  snap->scene_start = s.scene_start();
+  snap->kinetic_energy_per_ball = s.kinetic_energy_per_ball();
+  snap->contacts = s.contacts();
+  snap->tank = s.tank_min() ? TankBounds{to_vec3(*s.tank_min()), to_vec3(*s.tank_max())} : info_->tank;
   snap->ball_count = s.ball_count();
   if (s.positions()) snap->quantised.assign(s.positions()->begin(), s.positions()->end());  // length checked
   snap->kinds = kinds_;
   if (s.player_ids())
     for (flatbuffers::uoffset_t i = 0; i < s.player_ids()->size(); ++i)
       snap->players.push_back({s.player_ids()->Get(i), to_vec3(*s.player_positions()->Get(i))});
+  // Other balls under the same ids: nothing to blend with the old scene's.
+  if (const auto last = snapshots_.newest(); last && last->scene_start != snap->scene_start)
+    snapshots_.clear();
   snapshots_.push(std::move(snap));
   ++snapshots_this_second_;
 }

@@ -6,6 +6,7 @@
 //   connect ► Hello ► read frames ──decoded──► SnapshotBuffer ──► interpolate, draw
 //                  ◄ PlayerInput every 1/30 s ◄── set_velocity()
 //                  ◄ AddBalls                 ◄── add_balls()
+//                  ◄ Pause, Step, Reset, ...  ◄── send_command()
 //                  ◄ Ping every second; Pong gives the round trip
 //   any error ► "lost", wait a second, connect again (forever)
 //
@@ -49,6 +50,8 @@ class NetClient {
 
   void set_velocity(Vec3 velocity);
   void add_balls(std::uint32_t count);
+  // Sends a frame as it is (the sandbox's controls), if connected.
+  void send_command(protocol::Frame frame);
   ConnectionStatus status() const;
 
  private:

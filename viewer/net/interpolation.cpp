@@ -11,7 +11,7 @@ int interpolate(const RenderPair& pair, const ServerInfo& info, std::vector<Sphe
   const Snapshot& b = *pair.to;
   const float t = pair.alpha;
   const std::vector<std::uint8_t>& kinds = *b.kinds;
-  const TankBounds& tank = info.tank;
+  const TankBounds& tank = b.tank;  // a pair never spans two scene starts (NetClient clears the buffer)
   const Vec3 scale = tank.size() * (1.0f / 65535.0f);
 
   // Radius and colour per kind, looked up once rather than per ball.

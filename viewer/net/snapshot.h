@@ -22,6 +22,8 @@ struct ServerInfo {
   float dt = 0.0f;
   std::vector<BallKind> kinds;  // indexed by a ball's kind number
   std::uint32_t client_id = 0;
+  std::string control_policy;  // who may pause, step, reset, switch scene, set the time scale
+  bool may_control = false;    // whether this viewer may
   std::uint32_t player_id = 0;
   bool has_player = false;
 };
@@ -39,6 +41,13 @@ struct Snapshot {
   float load = 0.0f;
   std::uint32_t threads_stepping = 0;  // 0: the server did not say
   float time_scale = 0.0f;             // simulated seconds per wall second; 0: the server did not say
+  bool paused = false;
+  float time_scale_set = 0.0f;  // asked for (SetTimeScale); 0: the server did not say
+  std::string scene;
+  std::uint32_t scene_start = 0;         // +1 per scene (re)start: ball ids restart at 0
+  float kinetic_energy_per_ball = 0.0f;  // joules
+  std::uint32_t contacts = 0;
+  TankBounds tank;  // the scene's: the quantisation bounds (Welcome's when the server did not say)
   std::uint32_t ball_count = 0;
   // x, y, z per ball in id order, each 0..65535 over the tank bounds.
   std::vector<std::uint16_t> quantised;

@@ -5,6 +5,8 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <ctime>
+#include <filesystem>
 #include <vector>
 
 namespace fishtank::viewer {
@@ -20,6 +22,19 @@ bool save_screenshot(const std::string& path, int width, int height) {
     return false;
   }
   return true;
+}
+
+std::string new_screenshot_path() {
+  const std::time_t now = std::time(nullptr);
+  std::tm local{};
+  localtime_r(&now, &local);
+  char stem[32];
+  std::strftime(stem, sizeof stem, "fishtank-%Y%m%d-%H%M%S", &local);
+  std::error_code ec;
+  std::filesystem::path path = std::filesystem::absolute(std::string(stem) + ".png", ec);
+  for (int n = 2; std::filesystem::exists(path, ec); ++n)
+    path = std::filesystem::absolute(std::string(stem) + "-" + std::to_string(n) + ".png", ec);
+  return path.string();
 }
 
 }  // namespace fishtank::viewer

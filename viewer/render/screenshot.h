@@ -9,4 +9,8 @@ namespace fishtank::viewer {
 // False (with a message on stderr) when the file cannot be written.
 bool save_screenshot(const std::string& path, int width, int height);
 
+// A path in the working folder for a screenshot taken now, named by the local
+// time (fishtank-YYYYMMDD-HHMMSS.png, then -2, -3 ... within one second), absolute.
+std::string new_screenshot_path();
+
 }  // namespace fishtank::viewer

@@ -1,0 +1,368 @@
+"""A blocking client for fishtank-server's protocol (protocol/fishtank.fbs).
+
+Frames are FlatBuffers size-prefixed buffers: a 4-byte little-endian length,
+then a Message table with file identifier "FTNK" (protocol/frame_codec.h).
+The controls wait until a snapshot shows their effect, so a script reads
+like the experiment it runs; a refusal from the server raises FishtankError.
+"""
+
+import socket
+import struct
+import time
+from dataclasses import dataclass
+
+import flatbuffers
+import numpy as np
+
+from fishtank._protocol import PROTOCOL_VERSION
+from fishtank.wire import (AddBalls, BallKinds, Error, ErrorCode, Hello, Message, Pause, Payload, Ping,
+                           PlayerInput, Pong, Reset, SetTimeScale, Snapshot as WireSnapshot, Step, Vec3f, Welcome)
+
+_IDENTIFIER = b"FTNK"
+_MAX_FRAME_BYTES = 64 << 20  # the server's cap (kMaxServerFrameBytes)
+_QUANT_STEPS = np.float32(65535.0)  # protocol/quantize.h: kQuantSteps
+_ERROR_NAMES = {value: name for name, value in vars(ErrorCode.ErrorCode).items() if not name.startswith("_")}
+
+
+class FishtankError(RuntimeError):
+    """The server refused something; code is the protocol's ErrorCode name (e.g. "not_paused")."""
+
+    def __init__(self, code, message):
+        super().__init__(f"{code}: {message}")
+        self.code = code
+        self.message = message
+
+
+@dataclass
+class Snapshot:
+    """The world at one moment. Ball ids are 0 .. n-1 (ids[i] == i), kinds index Client.kinds."""
+
+    positions: np.ndarray  # (n, 3) float32, metres, dequantised as the viewer does
+    kinds: np.ndarray  # (n,) uint8
+    ids: np.ndarray  # (n,) uint32
+    player_ids: np.ndarray  # (p,) uint32
+    player_positions: np.ndarray  # (p, 3) float32
+    sim_time: float  # simulated seconds since the server started (a reset does not rewind it)
+    physics_steps: int
+    paused: bool
+    scene: str
+    scene_start: int  # +1 per scene (re)start
+    time_scale: float  # achieved: simulated seconds per wall second
+    time_scale_set: float  # asked for
+    steps_per_s: float
+    kinetic_energy_per_ball: float  # joules
+    contacts: int
+    tank_min: np.ndarray  # (3,) float32
+    tank_max: np.ndarray
+
+
+def _vec(v):
+    return np.array([v.X(), v.Y(), v.Z()], dtype=np.float32)
+
+
+def dequantize(q, lo, hi):
+    """protocol/quantize.h's dequantize, in float32 step by step: lo + q * ((hi - lo) / 65535)."""
+    lo = np.asarray(lo, dtype=np.float32)
+    step = (np.asarray(hi, dtype=np.float32) - lo) / _QUANT_STEPS
+    return lo + q.astype(np.float32) * step
+
+
+def _frame(payload_type, build):
+    b = flatbuffers.Builder(128)
+    payload = build(b)
+    Message.Start(b)
+    Message.AddPayloadType(b, payload_type)
+    Message.AddPayload(b, payload)
+    b.FinishSizePrefixed(Message.End(b), _IDENTIFIER)
+    return bytes(b.Output())
+
+
+class Client:
+    """One connection to fishtank-server.
+
+    player=True asks for a player sphere (move() needs one; under the server's
+    default --control policy only clients with one may pause, step, reset,
+    switch scene or set the time scale).
+    """
+
+    def __init__(self, host="127.0.0.1", port=7878, player=True, name="fishtank-python", timeout=10.0):
+        self.timeout = timeout
+        self._sock = socket.create_connection((host, port), timeout=timeout)
+        self._sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self._buffer = bytearray()
+        self._kinds = np.zeros(0, dtype=np.uint8)
+        self._newest = None  # the newest Snapshot read, not yet returned by snapshot()
+        self._last = None  # the newest Snapshot seen
+        self._sequence = 0
+        self._pong = None
+        self.errors = []  # every FishtankError the server sent, oldest first
+        self._unraised = []  # refusals not yet raised to the caller
+        self.welcome = None
+        self._send(_frame(Payload.Payload.Hello, lambda b: self._hello(b, name, player)))
+        deadline = time.monotonic() + timeout
+        while self.welcome is None:
+            self._read_one(deadline)
+        w = self.welcome
+        self.player_id = w.PlayerId() if w.HasPlayer() else None
+        self.dt = w.Dt()
+        self.may_control = w.MayControl()
+        self.control_policy = (w.ControlPolicy() or b"").decode()
+        self.kinds = [(w.BallKinds(k).Diameter(), w.BallKinds(k).Mass()) for k in range(w.BallKindsLength())]
+        self._tank = (_vec(w.TankMin()), _vec(w.TankMax()))
+
+    # ---- the API ----
+
+    def snapshot(self):
+        """The newest snapshot, waiting for one newer than the last returned if none has arrived."""
+        self._drain()
+        deadline = time.monotonic() + self.timeout
+        while self._newest is None:
+            self._read_one(deadline)
+        self._drain()
+        s, self._newest = self._newest, None
+        return s
+
+    def move(self, velocity):
+        """Sets the player sphere's velocity (metres per second, x y z); it keeps it until the next move()."""
+        if self.player_id is None:
+            raise FishtankError("no_player", "this client has no player sphere to move")
+        x, y, z = (float(c) for c in velocity)
+        self._sequence += 1
+
+        def build(b):
+            PlayerInput.Start(b)
+            PlayerInput.AddSequence(b, self._sequence)
+            PlayerInput.AddVelocity(b, Vec3f.CreateVec3f(b, x, y, z))
+            return PlayerInput.End(b)
+
+        self._send(_frame(Payload.Payload.PlayerInput, build))
+        self._check_refusals()
+
+    def add_balls(self, n):
+        """Asks the server to pour n more balls in from the top; raises FishtankError if it took fewer."""
+        self._send(_frame(Payload.Payload.AddBalls, lambda b: self._table(b, AddBalls, AddCount=int(n))))
+        self._round_trip()
+
+    def pause(self):
+        """Pauses the simulation for everyone and waits until a snapshot shows it."""
+        self._send(_frame(Payload.Payload.Pause, lambda b: self._table(b, Pause, AddPaused=True)))
+        return self._wait_for(lambda s: s.paused)
+
+    def resume(self):
+        self._send(_frame(Payload.Payload.Pause, lambda b: self._table(b, Pause, AddPaused=False)))
+        return self._wait_for(lambda s: not s.paused)
+
+    def step(self, n=1):
+        """Runs n steps while paused and returns the snapshot taken once they are done."""
+        before = self._current().physics_steps
+        self._send(_frame(Payload.Payload.Step, lambda b: self._table(b, Step, AddCount=int(n))))
+        return self._wait_for(lambda s: (s.physics_steps - before) % 2**32 >= n)
+
+    def reset(self, seed=None):
+        """Starts the running scene again (with this seed, or the scene's last) and returns its first snapshot."""
+        return self._restart(None, seed)
+
+    def scene(self, name, seed=None):
+        """Switches everyone to the named scene (tank, wide, dam-break, drop) and returns its first snapshot."""
+        return self._restart(name, seed)
+
+    def time_scale(self, scale):
+        """Asks for simulated seconds per wall second, 0.1 .. 1 (the server refuses other values)."""
+        scale = float(np.float32(scale))
+        self._send(_frame(Payload.Payload.SetTimeScale, lambda b: self._table(b, SetTimeScale, AddScale=scale)))
+        return self._wait_for(lambda s: s.time_scale_set == scale)
+
+    def close(self):
+        self._sock.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    # ---- sending ----
+
+    @staticmethod
+    def _hello(b, name, player):
+        text = b.CreateString(name)
+        Hello.Start(b)
+        Hello.AddProtocolVersion(b, PROTOCOL_VERSION)
+        Hello.AddClientName(b, text)
+        Hello.AddWantsPlayer(b, bool(player))
+        return Hello.End(b)
+
+    @staticmethod
+    def _table(b, module, **fields):
+        module.Start(b)
+        for adder, value in fields.items():
+            getattr(module, adder)(b, value)
+        return module.End(b)
+
+    def _restart(self, name, seed):
+        before = self._current().scene_start
+
+        def build(b):
+            text = b.CreateString(name) if name is not None else None
+            Reset.Start(b)
+            if text is not None:
+                Reset.AddScene(b, text)
+            if seed is not None:
+                Reset.AddSeed(b, int(seed))
+            return Reset.End(b)
+
+        self._send(_frame(Payload.Payload.Reset, build))
+        return self._wait_for(lambda s: s.scene_start != before)
+
+    def _send(self, frame):
+        self._sock.sendall(frame)
+
+    # ---- receiving ----
+
+    def _current(self):
+        """The newest snapshot received so far."""
+        self._drain()
+        if self._last is None:
+            self.snapshot()
+        return self._last
+
+    def _wait_for(self, done):
+        """Reads until a snapshot satisfies done (returned) or the server refuses (FishtankError)."""
+        deadline = time.monotonic() + self.timeout
+        while True:
+            self._check_refusals()
+            if self._newest is not None and done(self._newest):
+                s, self._newest = self._newest, None
+                return s
+            self._newest = None
+            self._read_one(deadline)
+
+    def _round_trip(self):
+        """Waits for a Pong, so that any immediate refusal of what was sent before has arrived."""
+        self._pong = None
+        stamp = int(time.monotonic() * 1e6) % 2**32
+        self._send(_frame(Payload.Payload.Ping, lambda b: self._table(b, Ping, AddClientTimeUs=stamp)))
+        deadline = time.monotonic() + self.timeout
+        while self._pong != stamp:
+            self._read_one(deadline)
+        # A physics-thread answer (AddBalls' tank_full) goes out before the first snapshot published after
+        # the command was applied; the second snapshot after the Pong is surely later than that.
+        for _ in range(2):
+            self._wait_for(lambda s: True)
+
+    def _check_refusals(self):
+        self._drain()
+        if self._unraised:
+            error = self._unraised[0]
+            self._unraised.clear()
+            raise error
+
+    def _drain(self):
+        """Handles every frame already received, without waiting."""
+        self._sock.setblocking(False)
+        try:
+            while True:
+                chunk = self._sock.recv(1 << 20)
+                if not chunk:
+                    raise ConnectionError("the server closed the connection")
+                self._buffer += chunk
+        except BlockingIOError:
+            pass
+        finally:
+            self._sock.settimeout(self.timeout)
+        while self._handle_buffered():
+            pass
+
+    def _read_one(self, deadline):
+        """Handles at least one more frame, waiting until the deadline for it."""
+        while not self._handle_buffered():
+            left = deadline - time.monotonic()
+            if left <= 0:
+                raise TimeoutError("no answer from the server in time")
+            self._sock.settimeout(left)
+            chunk = self._sock.recv(1 << 20)
+            if not chunk:
+                raise ConnectionError("the server closed the connection" + self._last_error_text())
+            self._buffer += chunk
+        self._sock.settimeout(self.timeout)
+
+    def _last_error_text(self):
+        return f" ({self.errors[-1]})" if self.errors else ""
+
+    def _handle_buffered(self):
+        """Handles one complete frame from the buffer; False when none is complete."""
+        if len(self._buffer) < 4:
+            return False
+        (length,) = struct.unpack_from("<I", self._buffer)
+        if length < 8 or length > _MAX_FRAME_BYTES:
+            raise ConnectionError(f"frame length {length} is outside 8 .. {_MAX_FRAME_BYTES} bytes")
+        if len(self._buffer) < 4 + length:
+            return False
+        frame = bytes(self._buffer[: 4 + length])
+        del self._buffer[: 4 + length]
+        if frame[8:12] != _IDENTIFIER:
+            raise ConnectionError("not a Fishtank frame (file identifier is not FTNK)")
+        self._handle(Message.Message.GetRootAs(frame, 4))
+        return True
+
+    def _handle(self, m):
+        kind = m.PayloadType()
+        table = m.Payload()
+        if table is None:
+            return
+        if kind == Payload.Payload.Welcome:
+            self.welcome = Welcome.Welcome()
+            self.welcome.Init(table.Bytes, table.Pos)
+        elif kind == Payload.Payload.BallKinds:
+            k = BallKinds.BallKinds()
+            k.Init(table.Bytes, table.Pos)
+            first = k.FirstNewBall()
+            if first > len(self._kinds):
+                raise ConnectionError("the server skipped ball kinds")
+            # Earlier than the kinds known: a scene started again, ids restart.
+            self._kinds = np.concatenate([self._kinds[:first], k.KindsAsNumpy()]).astype(np.uint8)
+        elif kind == Payload.Payload.Snapshot:
+            s = WireSnapshot.Snapshot()
+            s.Init(table.Bytes, table.Pos)
+            self._newest = self._last = self._decode_snapshot(s)
+        elif kind == Payload.Payload.Error:
+            e = Error.Error()
+            e.Init(table.Bytes, table.Pos)
+            error = FishtankError(_ERROR_NAMES.get(e.Code(), str(e.Code())), (e.Message() or b"").decode())
+            self.errors.append(error)
+            if self.welcome is None:
+                raise error
+            if error.code != "player_limit":  # the Welcome says so too: this client observes
+                self._unraised.append(error)
+        elif kind == Payload.Payload.Pong:
+            p = Pong.Pong()
+            p.Init(table.Bytes, table.Pos)
+            self._pong = p.ClientTimeUs()
+
+    def _decode_snapshot(self, s):
+        n = s.BallCount()
+        lo, hi = (_vec(s.TankMin()), _vec(s.TankMax())) if s.TankMin() is not None else self._tank
+        q = s.PositionsAsNumpy() if n else np.zeros(0, dtype=np.uint16)
+        if len(q) != 3 * n or len(self._kinds) < n:
+            raise ConnectionError("a snapshot's positions or kinds do not match its ball count")
+        players = s.PlayerPositionsLength()
+        return Snapshot(
+            positions=dequantize(q.reshape(n, 3), lo, hi),
+            kinds=self._kinds[:n].copy(),
+            ids=np.arange(n, dtype=np.uint32),
+            player_ids=s.PlayerIdsAsNumpy().astype(np.uint32) if players else np.zeros(0, dtype=np.uint32),
+            player_positions=np.array([_vec(s.PlayerPositions(i)) for i in range(players)],
+                                      dtype=np.float32).reshape(players, 3),
+            sim_time=s.SimTime(),
+            physics_steps=s.PhysicsSteps(),
+            paused=s.Paused(),
+            scene=(s.Scene() or b"").decode(),
+            scene_start=s.SceneStart(),
+            time_scale=s.TimeScale(),
+            time_scale_set=s.TimeScaleSet(),
+            steps_per_s=s.StepsPerS(),
+            kinetic_energy_per_ball=s.KineticEnergyPerBall(),
+            contacts=s.Contacts(),
+            tank_min=lo,
+            tank_max=hi,
+        )

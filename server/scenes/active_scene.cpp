@@ -1,0 +1,26 @@
+#include "server/scenes/active_scene.h"
+
+namespace fishtank {
+
+SceneSpec ActiveScene::spec() const {
+  SceneSpec spec;
+  spec.name = choice_.name;
+  spec.seed = choice_.seed;
+  spec.balls = choice_.balls.value_or(default_balls(choice_.name));
+  return spec;
+}
+
+std::string ActiveScene::start(World& world, const std::optional<std::string>& scene,
+                               std::optional<std::uint64_t> seed) {
+  if (scene) choice_.name = *scene;
+  if (seed) choice_.seed = *seed;
+  const SceneSpec s = spec();
+  world.restart(scene_tank(s), s.seed);
+  if (choice_.max_balls > 0) world.set_max_balls(choice_.max_balls);
+  std::string refusal = populate(world, s);
+  world.respawn_players();
+  ++starts_;
+  return refusal;
+}
+
+}  // namespace fishtank

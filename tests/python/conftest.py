@@ -1,0 +1,59 @@
+"""A real fishtank-server on an ephemeral 127.0.0.1 port for each test (FISHTANK_SERVER names the executable)."""
+
+import os
+import re
+import signal
+import subprocess
+import tempfile
+import time
+
+import pytest
+
+
+class Server:
+    def __init__(self, *args):
+        self.log = tempfile.NamedTemporaryFile(prefix="fishtank-server-", suffix=".log", delete=False)
+        self.process = subprocess.Popen(
+            [os.environ["FISHTANK_SERVER"], "--bind", "127.0.0.1", "--port", "0", "--threads", "1", *args],
+            stderr=self.log, stdout=subprocess.DEVNULL)
+        deadline = time.monotonic() + 15
+        while time.monotonic() < deadline:
+            found = re.search(r"listening on 127\.0\.0\.1:(\d+)", self.text())
+            if found:
+                self.port = int(found.group(1))
+                return
+            if self.process.poll() is not None:
+                break
+            time.sleep(0.05)
+        self.stop()
+        raise RuntimeError("fishtank-server did not start listening:\n" + self.text())
+
+    def text(self):
+        with open(self.log.name, encoding="utf-8", errors="replace") as f:
+            return f.read()
+
+    def stop(self):
+        """SIGTERM, then the exit status (the server writes its --dump on the way out)."""
+        if self.process.poll() is None:
+            self.process.send_signal(signal.SIGTERM)
+            try:
+                self.process.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait()
+        os.unlink(self.log.name)
+        return self.process.returncode
+
+
+@pytest.fixture
+def start_server():
+    started = []
+
+    def start(*args):
+        started.append(Server(*args))
+        return started[-1]
+
+    yield start
+    for server in started:
+        if server.process.poll() is None:
+            server.stop()

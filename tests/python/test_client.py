@@ -1,0 +1,118 @@
+"""The Python client against a real server: snapshots come out as numpy arrays
+that agree with the server's own state; the controls do what they say
+(pause holds, step runs exactly N, the same seed restarts the same run bit for
+bit, a time scale of one half halves the pace); refusals raise FishtankError
+and leave the connection working."""
+
+import time
+
+import numpy as np
+import pytest
+
+from fishtank import Client, FishtankError
+
+
+def test_a_snapshot_gives_positions_kinds_and_ids_as_numpy_arrays_inside_the_tank(start_server):
+    server = start_server("--balls", "300")
+    with Client("127.0.0.1", server.port) as tank:
+        deadline = time.monotonic() + 10
+        s = tank.snapshot()
+        while s.positions.shape[0] < 300 and time.monotonic() < deadline:
+            s = tank.snapshot()
+        assert s.positions.shape == (300, 3) and s.positions.dtype == np.float32
+        assert s.kinds.shape == (300,) and s.kinds.dtype == np.uint8
+        assert np.array_equal(s.ids, np.arange(300, dtype=np.uint32))
+        assert sorted(np.bincount(s.kinds).tolist()) == [100, 100, 100]  # three sizes in equal numbers
+        assert np.all(s.positions >= s.tank_min) and np.all(s.positions <= s.tank_max)
+        assert s.scene == "tank" and not s.paused
+        assert tank.player_id is not None and s.player_ids.tolist() == [tank.player_id]
+
+
+def test_positions_agree_with_the_servers_own_state_within_half_a_quantisation_step(start_server, tmp_path):
+    dump = tmp_path / "final.csv"
+    server = start_server("--scene", "drop", "--balls", "400", "--dump", str(dump))
+    with Client("127.0.0.1", server.port) as tank:
+        tank.pause()
+        tank.step(300)  # the balls are falling: positions that differ from the start
+        s = tank.snapshot()
+    assert server.stop() == 0
+    state = np.loadtxt(dump, delimiter=",", skiprows=1, dtype=np.float64)  # x,y,z,... in id order
+    half_step = 0.5 * (s.tank_max - s.tank_min) / 65535.0
+    error = np.abs(s.positions - state[:, :3])
+    assert np.all(error <= half_step * 1.01 + 1e-5), error.max(axis=0)
+
+
+def test_pause_holds_still_and_step_runs_exactly_the_steps_asked_for(start_server):
+    server = start_server("--balls", "200")
+    with Client("127.0.0.1", server.port) as tank:
+        paused = tank.pause()
+        time.sleep(0.3)
+        still = tank.snapshot()
+        assert still.paused and still.physics_steps == paused.physics_steps
+        assert np.array_equal(still.positions, paused.positions)
+        stepped = tank.step(40)
+        assert stepped.physics_steps == paused.physics_steps + 40
+        assert stepped.sim_time == pytest.approx(paused.sim_time + 40 * tank.dt, rel=1e-6)
+        running = tank.resume()
+        assert not running.paused
+
+
+def test_a_reset_with_the_same_seed_replays_the_run_bit_for_bit_and_another_seed_does_not(start_server):
+    server = start_server("--balls", "300")
+    with Client("127.0.0.1", server.port) as tank:
+        tank.pause()
+        runs = {}
+        for label, seed in (("first", 4), ("again", 4), ("other", 5)):
+            start = tank.scene("dam-break", seed=seed)
+            assert start.scene == "dam-break" and start.positions.shape == (300, 3)
+            runs[label] = tank.step(500).positions
+        assert np.array_equal(runs["first"], runs["again"])
+        assert not np.array_equal(runs["first"], runs["other"])
+        assert tank.reset().scene == "dam-break"  # reset keeps the scene running
+
+
+def test_a_time_scale_of_one_half_runs_simulated_time_at_half_the_wall_clocks_pace(start_server):
+    server = start_server("--balls", "100")
+    with Client("127.0.0.1", server.port) as tank:
+        assert tank.time_scale(0.5).time_scale_set == 0.5
+        before, wall = tank.snapshot().sim_time, time.monotonic()
+        time.sleep(1.5)
+        after, wall_after = tank.snapshot().sim_time, time.monotonic()
+        assert (after - before) / (wall_after - wall) == pytest.approx(0.5, abs=0.08)
+
+
+def test_move_drives_the_player_sphere_and_add_balls_pours_more_in(start_server):
+    server = start_server("--balls", "100", "--max-balls", "250")
+    with Client("127.0.0.1", server.port) as tank:
+        start = tank.snapshot().player_positions[0]
+        tank.move((4.0, 0.0, 0.0))
+        time.sleep(1.0)
+        moved = tank.snapshot().player_positions[0]
+        assert moved[0] > start[0] + 2.0
+        tank.add_balls(100)
+        deadline = time.monotonic() + 10
+        while tank.snapshot().positions.shape[0] < 200 and time.monotonic() < deadline:
+            pass
+        assert tank.snapshot().positions.shape[0] == 200
+        with pytest.raises(FishtankError) as full:
+            tank.add_balls(100)  # 250 at most
+        assert full.value.code == "tank_full"
+
+
+def test_refusals_raise_with_the_servers_reason_and_the_connection_keeps_working(start_server):
+    server = start_server("--balls", "50")
+    with Client("127.0.0.1", server.port) as tank, Client("127.0.0.1", server.port, player=False) as observer:
+        with pytest.raises(FishtankError) as running:
+            tank.step(5)
+        assert running.value.code == "not_paused"
+        with pytest.raises(FishtankError) as unknown:
+            tank.scene("cube")
+        assert unknown.value.code == "invalid_value" and "tank, wide, dam-break and drop" in unknown.value.message
+        with pytest.raises(FishtankError) as fast:
+            tank.time_scale(5)
+        assert fast.value.code == "invalid_value"
+        assert not observer.may_control and "observers may not" in observer.control_policy
+        with pytest.raises(FishtankError) as refused:
+            observer.pause()
+        assert refused.value.code == "not_permitted"
+        assert not tank.snapshot().paused and observer.snapshot().scene == "tank"

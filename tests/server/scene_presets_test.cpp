@@ -1,0 +1,149 @@
+// The scene presets and their (re)starts: every preset puts exactly its balls
+// in its tank, none touching another; the dam-break column stands against
+// one wall and collapses away from it; the drop's large balls start above the
+// small bed; a restart with the same seed reproduces the run bit for bit, a
+// switch of scene changes the tank, restarts ball ids and keeps the players
+// inside.
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "server/scenes/active_scene.h"
+
+using namespace fishtank;
+
+namespace {
+
+SceneSpec preset(const char* name) {
+  SceneSpec spec;
+  spec.name = name;
+  spec.balls = default_balls(name);
+  return spec;
+}
+
+World world_for(const SceneSpec& spec) {
+  PhysicsParams params;
+  params.tank = scene_tank(spec);
+  return World(params, kSseKernels, 1, spec.seed);
+}
+
+// The smallest gap between two balls' surfaces (negative: they overlap).
+float closest_gap(const World& world) {
+  const Float4* p = world.positions();
+  float closest = 1e9f;
+  for (std::uint32_t i = 0; i < world.ball_count(); ++i)
+    for (std::uint32_t j = i + 1; j < world.ball_count(); ++j) {
+      const float dx = p[i].x - p[j].x, dy = p[i].y - p[j].y, dz = p[i].z - p[j].z;
+      closest = std::min(closest, std::sqrt(dx * dx + dy * dy + dz * dz) - p[i].w - p[j].w);
+    }
+  return closest;
+}
+
+void run_steps(World& world, int steps) {
+  for (int s = 0; s < steps; ++s) world.step();
+}
+
+}  // namespace
+
+TEST_CASE("every placed preset holds exactly its balls, inside its tank, none touching", "[scenes]") {
+  for (const char* name : {"wide", "dam-break", "drop"}) {
+    INFO(name);
+    const SceneSpec spec = preset(name);
+    World world = world_for(spec);
+    REQUIRE(populate(world, spec).empty());
+    CHECK(world.ball_count() == spec.balls);
+    CHECK(world.escaped_or_invalid() == 0);
+    CHECK(closest_gap(world) > 0.0f);
+  }
+  const SceneSpec tank = preset("tank");
+  World poured = world_for(tank);
+  REQUIRE(populate(poured, tank).empty());
+  CHECK(poured.ball_count() + poured.pending() == 1000);  // poured in from the top over the first steps
+}
+
+TEST_CASE("the dam-break column stands against the -x wall and spreads across the floor once released", "[scenes]") {
+  const SceneSpec spec = preset("dam-break");
+  World world = world_for(spec);
+  REQUIRE(populate(world, spec).empty());
+  const auto front = [&] {
+    float x = -1e9f;
+    for (std::uint32_t i = 0; i < world.ball_count(); ++i) x = std::max(x, world.positions()[i].x);
+    return x;
+  };
+  const float tank_min_x = world.params().tank.min.x;
+  const float start = front();
+  CHECK(start < tank_min_x + 6.0f);
+  run_steps(world, static_cast<int>(2.0 / world.dt()));
+  INFO("front from x = " << start << " to " << front());
+  CHECK(front() > start + 10.0f);  // a 17-unit column falling over reaches well beyond its width
+  CHECK(world.escaped_or_invalid() == 0);
+}
+
+TEST_CASE("the drop scene's large balls all start above its bed of small ones", "[scenes]") {
+  const SceneSpec spec = preset("drop");
+  World world = world_for(spec);
+  REQUIRE(populate(world, spec).empty());
+  float bed_top = -1e9f, lowest_large = 1e9f;
+  std::uint32_t large = 0;
+  for (std::uint32_t i = 0; i < world.ball_count(); ++i) {
+    const Float4& p = world.positions()[i];
+    if (world.kinds()[i] == 0) bed_top = std::max(bed_top, p.y + p.w);
+    if (world.kinds()[i] == kKindCount - 1) lowest_large = std::min(lowest_large, p.y - p.w), ++large;
+  }
+  CHECK(large == spec.balls / 10);
+  CHECK(lowest_large > bed_top + 10.0f);
+}
+
+TEST_CASE("a restart with the same seed reproduces the run bit for bit, another seed does not", "[scenes]") {
+  for (const char* name : {"tank", "wide"}) {
+    INFO(name);
+    SceneChoice choice;
+    choice.name = name;
+    choice.balls = 300;
+    ActiveScene scene(choice);
+    PhysicsParams params;
+    params.tank = scene.first_tank();
+    World world(params, kSseKernels, 1, 1);
+    REQUIRE(scene.start(world).empty());
+    run_steps(world, 400);
+    const std::uint64_t first = world.state_hash();
+    REQUIRE(scene.start(world).empty());  // the same scene, the same seed
+    CHECK(world.ball_count() <= 300);
+    run_steps(world, 400);
+    CHECK(world.state_hash() == first);
+    REQUIRE(scene.start(world, std::nullopt, 2).empty());
+    run_steps(world, 400);
+    CHECK(world.state_hash() != first);
+    CHECK(scene.seed() == 2);
+    CHECK(scene.start_count() == 3);
+  }
+}
+
+TEST_CASE("switching scene changes the tank, restarts ball ids at 0 and keeps every player inside", "[scenes]") {
+  ActiveScene scene(SceneChoice{});  // each scene's own number of balls
+  PhysicsParams params;
+  params.tank = scene.first_tank();
+  World world(params, kSseKernels, 1, 1);
+  REQUIRE(scene.start(world).empty());
+  const std::uint32_t a = world.add_player(), b = world.add_player();
+  run_steps(world, 2000);
+  REQUIRE(scene.start(world, std::string("wide")).empty());
+  CHECK(scene.name() == "wide");
+  CHECK(world.params().tank.size().x > 40.0f);
+  CHECK(world.ball_count() == default_balls("wide"));
+  const std::uint32_t* ids = world.ids();
+  CHECK(*std::max_element(ids, ids + world.ball_count()) == default_balls("wide") - 1);
+  const TankBounds& t = world.params().tank;
+  for (std::uint32_t id : {a, b}) {
+    const Vec3 p = world.player_position(id);
+    CHECK(p.x > t.min.x);
+    CHECK(p.x < t.max.x);
+    CHECK(p.y > t.min.y);
+    CHECK(p.y < t.max.y);
+  }
+  const Vec3 apart = world.player_position(a) - world.player_position(b);
+  CHECK(std::sqrt(dot(apart, apart)) >= kPlayerDiameter);
+  run_steps(world, 500);
+  CHECK(world.escaped_or_invalid() == 0);
+}
