@@ -146,7 +146,8 @@ TEST_CASE("a thread three times slower computes about a quarter of the items", "
   std::nth_element(slow_share.begin(), slow_share.begin() + slow_share.size() / 2, slow_share.end());
   const double median = slow_share[slow_share.size() / 2];
   INFO("thread 1's share " << median);
-  // Equal shares would be 0.5; chunks of an eighth of the items allow 0.25 +- 0.125.
-  CHECK(median < 0.4);
+  // Equal shares would be 0.5; in chunks of an eighth the slow thread takes 2 (0.25), or 3 (0.375)
+  // when a busy machine delays the fast one.
+  CHECK(median < 0.45);
   CHECK(median > 0.1);
 }
