@@ -105,6 +105,7 @@ fishtank::net::ServerInfo server_info(const fishtank::World& world, const fishta
   info.tank = world.params().tank;
   info.dt = world.dt();
   info.snapshot_rate_hz = static_cast<float>(o.snapshot_rate);
+  info.limits = o.limits;
   return info;
 }
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "server/bench/benchmark.h"
+#include "server/net/client_limits.h"
 #include "server/physics/params.h"
 
 namespace fishtank {
@@ -31,6 +32,7 @@ struct ServerOptions {
   std::uint16_t port = 7878;  // 0: an ephemeral port, printed at start
   double snapshot_rate = 60.0;
   std::uint32_t max_players = 8;
+  net::ClientLimits limits;
 };
 
 struct ParseResult {

@@ -33,7 +33,7 @@ std::string read_file(const std::string& path) {
 }
 }  // namespace
 
-ServerProcess::ServerProcess(const std::vector<std::string>& args) {
+ServerProcess::ServerProcess(const std::vector<std::string>& args, const std::vector<std::string>& launcher) {
   static int counter = 0;
   log_path_ = (std::filesystem::temp_directory_path() /
                ("fishtank-net-test-" + std::to_string(getpid()) + "-" + std::to_string(counter++) + ".log"))
@@ -45,6 +45,7 @@ ServerProcess::ServerProcess(const std::vector<std::string>& args) {
   if (std::find(args.begin(), args.end(), "--threads") == args.end())
     argv_text.insert(argv_text.end(), {"--threads", "1"});
   argv_text.insert(argv_text.end(), args.begin(), args.end());
+  argv_text.insert(argv_text.begin(), launcher.begin(), launcher.end());
   std::vector<char*> argv;
   for (std::string& a : argv_text) argv.push_back(a.data());
   argv.push_back(nullptr);
