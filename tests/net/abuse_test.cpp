@@ -103,6 +103,31 @@ void check_rss_growth(long growth_kb, long limit_kb) {
 #endif
 }
 
+// A peer that says Hello and then reads nothing, sending PlayerInput all the
+// while when `sends`: --idle-timeout closes it with `code`.
+void check_non_reader(bool sends, const std::string& code, const std::string& attack) {
+  // Large, frequent snapshots fill the kernel's socket buffers (megabytes on
+  // loopback) within a second or two; only then can a write stall.
+  ServerProcess server({"--balls", "500", "--snapshot-rate", "500", "--idle-timeout", "1"});
+  auto honest = honest_viewer(server);
+  RawSocket peer(server.port(), /*receive_buffer=*/4096);
+  peer.send(protocol::encode_hello("non-reader", false));
+  std::uint32_t sequence = 0;
+  double seconds = 0.0;
+  const double rate = snapshot_rate(*honest, [&] {
+    seconds = wait_for_log(server, code, 15s, [&] {
+      if (sends) peer.send(protocol::encode_player_input(++sequence, {0.0f, 0.0f, 0.0f}));
+    });
+  });
+  std::vector<std::uint8_t> got;
+  const bool closed = peer.read_until_closed(got, 5s);
+  record(attack, "--idle-timeout 1 (default 30)",
+         "closed after " + fixed(seconds, "s") + " with " + code + " (the socket buffers fill first)", rate, 500);
+  CHECK(closed);
+  CHECK(contains(error_codes(got), code));
+  CHECK(rate >= kHonestRate);
+}
+
 }  // namespace
 
 TEST_CASE("abuse: 500 strangers announce a 1 MiB first frame and stall - refused at once, memory flat", "[abuse]") {
@@ -200,44 +225,11 @@ TEST_CASE("abuse: a Hello sent one byte at a time is cut off at the Hello deadli
 }
 
 TEST_CASE("abuse: a client that says Hello, then neither reads nor sends, is closed with idle_timeout", "[abuse]") {
-  // Large, frequent snapshots fill the kernel's socket buffers (megabytes on
-  // loopback) within a second or two; only then can a write stall.
-  ServerProcess server({"--balls", "500", "--snapshot-rate", "500", "--idle-timeout", "1"});
-  auto honest = honest_viewer(server);
-  RawSocket mute(server.port(), /*receive_buffer=*/4096);
-  mute.send(protocol::encode_hello("mute", false));
-  double seconds = 0.0;
-  const double rate = snapshot_rate(*honest, [&] { seconds = wait_for_log(server, "idle_timeout", 15s); });
-  std::vector<std::uint8_t> got;
-  const bool closed = mute.read_until_closed(got, 5s);
-  record("Hello, then nothing sent and nothing read", "--idle-timeout 1 (default 30)",
-         "closed after " + fixed(seconds, "s") + " with idle_timeout (the socket buffers fill first)", rate, 500);
-  CHECK(closed);
-  CHECK(contains(error_codes(got), "idle_timeout"));
-  CHECK(rate >= kHonestRate);
+  check_non_reader(/*sends=*/false, "idle_timeout", "Hello, then nothing sent and nothing read");
 }
 
 TEST_CASE("abuse: a client that sends input but never reads is closed with too_slow", "[abuse]") {
-  // Large, frequent snapshots fill the kernel's socket buffers (megabytes on
-  // loopback) within a second or two; only then can a write stall.
-  ServerProcess server({"--balls", "500", "--snapshot-rate", "500", "--idle-timeout", "1"});
-  auto honest = honest_viewer(server);
-  RawSocket deaf(server.port(), /*receive_buffer=*/4096);
-  deaf.send(protocol::encode_hello("deaf", false));
-  std::uint32_t sequence = 0;
-  double seconds = 0.0;
-  const double rate = snapshot_rate(*honest, [&] {
-    seconds = wait_for_log(server, "too_slow", 15s, [&] {
-      deaf.send(protocol::encode_player_input(++sequence, {0.0f, 0.0f, 0.0f}));
-    });
-  });
-  std::vector<std::uint8_t> got;
-  const bool closed = deaf.read_until_closed(got, 5s);
-  record("Hello, then PlayerInput 20 times a second, nothing read", "--idle-timeout 1 (default 30)",
-         "closed after " + fixed(seconds, "s") + " with too_slow", rate, 500);
-  CHECK(closed);
-  CHECK(contains(error_codes(got), "too_slow"));
-  CHECK(rate >= kHonestRate);
+  check_non_reader(/*sends=*/true, "too_slow", "Hello, then PlayerInput 20 times a second, nothing read");
 }
 
 TEST_CASE("abuse: players who never move lose their spheres to a newcomer (player_idle)", "[abuse]") {
@@ -249,9 +241,7 @@ TEST_CASE("abuse: players who never move lose their spheres to a newcomer (playe
   REQUIRE(squatter2.wait_until(has_player, 5s));
   const Clock::time_point start = Clock::now();
   double seconds = 0.0;
-  const auto freed = [](const ClientState& s) {
-    return std::find(s.error_codes.begin(), s.error_codes.end(), "player_idle") != s.error_codes.end();
-  };
+  const auto freed = [](const ClientState& s) { return contains(s.error_codes, "player_idle"); };
   const double rate = snapshot_rate(*honest, [&] {
     squatter1.wait_until(freed, 5s);
     squatter2.wait_until(freed, 5s);
