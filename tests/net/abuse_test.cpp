@@ -324,11 +324,12 @@ TEST_CASE("abuse: out of file descriptors, the acceptor backs off, logs once per
   for (std::size_t at = log.find("accept failed"); at != std::string::npos; at = log.find("accept failed", at + 1))
     ++warnings;
   crowd.clear();
+  // The acceptor may be in its longest back-off (1.6 s) when room appears.
   BackgroundClient newcomer(server.port(), false, "newcomer");
-  const bool admitted = newcomer.wait_until([](const ClientState& s) { return s.welcomed; }, 5s);
+  const bool admitted = newcomer.wait_until([](const ClientState& s) { return s.welcomed; }, 10s);
   record("60 connections with 40 file descriptors", "accept backs off 100 ms doubling to 1.6 s",
          std::to_string(warnings) + " log warnings in 3 s; a newcomer was welcomed afterwards", rate);
-  INFO(log.substr(0, 4000));
+  INFO(server.log().substr(server.log().size() > 4000 ? server.log().size() - 4000 : 0));
   CHECK(warnings >= 1);
   CHECK(warnings <= 10);
   CHECK(admitted);

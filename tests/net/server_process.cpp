@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -78,6 +79,15 @@ ServerProcess::~ServerProcess() {
     waitpid(pid_, nullptr, 0);
   }
   std::error_code ignored;
+  // scripts/test-asan: a server's sanitizer report fails the run even when the
+  // test that started the server passed, so its log is kept for the script.
+  if (const char* reports = std::getenv("FISHTANK_SANITIZER_REPORTS")) {
+    const std::string text = log();
+    if (text.find("runtime error:") != std::string::npos || text.find("Sanitizer") != std::string::npos)
+      std::filesystem::copy_file(log_path_,
+                                 std::filesystem::path(reports) / std::filesystem::path(log_path_).filename(),
+                                 std::filesystem::copy_options::overwrite_existing, ignored);
+  }
   std::filesystem::remove(log_path_, ignored);
 }
 

@@ -345,10 +345,12 @@ TEST_CASE("clients that never read: the server's memory stays bounded and others
   // AddressSanitizer keeps freed blocks in quarantine (256 MB by default), so
   // the server's RSS grows with every freed snapshot; the Release run checks it.
   WARN("AddressSanitizer build: RSS not meaningful (" << rss_end - rss_start << " kB growth)");
+  // The instrumented server encodes and sends a few times slower; the watcher must still be served.
+  CHECK(rate > 100.0);
 #else
   CHECK(rss_end - rss_start < 8 * 1024);  // unbounded queues would add ~50 MB here
+  CHECK(rate > 300.0);                    // 400 Hz asked
 #endif
-  CHECK(rate > 300.0);  // 400 Hz asked
   CHECK(server.running());
   CHECK(watcher->stats().errors.empty());
 }
