@@ -48,12 +48,14 @@ inline F8& operator-=(F8& a, F8 b) { return a = a - b; }
 inline F8 sqrt(F8 a) { return {_mm256_sqrt_ps(a.v)}; }
 // a * b + c in one rounding.
 inline F8 mul_add(F8 a, F8 b, F8 c) { return {_mm256_fmadd_ps(a.v, b.v, c.v)}; }
-// -1/sqrt(a) to about 1e-7 relative: the 12-bit estimate plus one Newton
-// step, negated as the SSE version is (sse_float4.h).
-inline F8 neg_rsqrt(F8 a) {
+// c - a * b in one rounding.
+inline F8 neg_mul_add(F8 a, F8 b, F8 c) { return {_mm256_fnmadd_ps(a.v, b.v, c.v)}; }
+// 1/sqrt(a) to about 1e-7 relative: the 12-bit estimate plus one Newton step,
+// r (1.5 - a r^2 / 2), as in sse_float4.h.
+inline F8 rsqrt(F8 a) {
   __m256 r = _mm256_rsqrt_ps(a.v);
-  __m256 half_a_r2 = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), a.v), _mm256_mul_ps(r, r));
-  return {_mm256_mul_ps(r, _mm256_sub_ps(half_a_r2, _mm256_set1_ps(1.5f)))};
+  __m256 neg_half_a_r2 = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(-0.5f), a.v), _mm256_mul_ps(r, r));
+  return {_mm256_mul_ps(r, _mm256_add_ps(neg_half_a_r2, _mm256_set1_ps(1.5f)))};
 }
 inline F8 max(F8 a, F8 b) { return {_mm256_max_ps(a.v, b.v)}; }
 inline M8 operator<(F8 a, F8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_LT_OQ)}; }

@@ -39,20 +39,19 @@ inline F4 operator/(F4 a, F4 b) { return {_mm_div_ps(a.v, b.v)}; }
 inline F4& operator+=(F4& a, F4 b) { return a = a + b; }
 inline F4& operator-=(F4& a, F4 b) { return a = a - b; }
 inline F4 sqrt(F4 a) { return {_mm_sqrt_ps(a.v)}; }
-// -1/sqrt(a) to about 1e-7 relative: the 12-bit hardware estimate plus one
-// Newton step. Where a loop already divides once (the neighbour forces), a
-// second sqrt and divide measured slower: the two share one unit.
-// Negated because SSE's two-operand subtract can then take the constant from
-// memory (h - 1.5) instead of rebuilding it in a register for 1.5 - h on every
-// call; the negation is exact.
-inline F4 neg_rsqrt(F4 a) {
+// 1/sqrt(a) to about 1e-7 relative: the 12-bit estimate plus one Newton step,
+// r (1.5 - a r^2 / 2). Written as (-a/2) r^2 + 1.5, the same bits, so that
+// SSE's two-operand add takes 1.5 from memory instead of a register copy.
+inline F4 rsqrt(F4 a) {
   __m128 r = _mm_rsqrt_ps(a.v);
-  __m128 half_a_r2 = _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(0.5f), a.v), _mm_mul_ps(r, r));
-  return {_mm_mul_ps(r, _mm_sub_ps(half_a_r2, _mm_set1_ps(1.5f)))};
+  __m128 neg_half_a_r2 = _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(-0.5f), a.v), _mm_mul_ps(r, r));
+  return {_mm_mul_ps(r, _mm_add_ps(neg_half_a_r2, _mm_set1_ps(1.5f)))};
 }
 inline F4 max(F4 a, F4 b) { return {_mm_max_ps(a.v, b.v)}; }
 // a * b + c, rounded twice as in the scalar twin: SSE4.1 has no fused form.
 inline F4 mul_add(F4 a, F4 b, F4 c) { return a * b + c; }
+// c - a * b, rounded twice.
+inline F4 neg_mul_add(F4 a, F4 b, F4 c) { return c - a * b; }
 // The largest of the four lanes.
 inline float max_lane(F4 a) {
   const __m128 m = _mm_max_ps(a.v, _mm_movehl_ps(a.v, a.v));  // max(0, 2), max(1, 3)

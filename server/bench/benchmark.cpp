@@ -23,7 +23,7 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   // whose threads share lines (line_transfer.h).
   const std::optional<LineTransfer> transfer_before = time_line_transfer();
   const PhaseSeconds before = world.phase_seconds();
-  const std::uint64_t rebuilds_before = world.rebuilds(), kept_before = world.lists_kept_far();
+  const std::uint64_t rebuilds_before = world.rebuilds(), kept_before = world.lists_kept_by_checks();
   world.reset_thread_shares();
   const std::uint64_t one_thread_before = world.steps_on_one_thread();
   // A shared machine's noise comes in bursts: timing several windows and
@@ -77,7 +77,7 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   j["mean_neighbours"] = world.mean_neighbours();
   j["rebuilds"] = world.rebuilds() - rebuilds_before;
   // Steps that kept the lists after checking the balls that moved past skin/2.
-  j["lists_kept_after_check"] = world.lists_kept_far() - kept_before;
+  j["lists_kept_after_check"] = world.lists_kept_by_checks() - kept_before;
   j["kinetic_energy_per_ball"] = world.ball_count() ? world.kinetic_energy() / world.ball_count() : 0.0;
   j["settle"] = {{"settled", settle.settled},
                  {"sim_seconds", settle.sim_seconds},
@@ -85,7 +85,7 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
                  {"steps", settle.steps}};
   j["phase_seconds"] = {
       {"neighbours", after.neighbours - before.neighbours}, {"sort", after.sort - before.sort},
-      {"list_build", after.list_build - before.list_build}, {"far_checks", after.far_checks - before.far_checks},
+      {"list_build", after.list_build - before.list_build}, {"far_checks", after.stray_checks - before.stray_checks},
       {"step_pass", after.step_pass - before.step_pass},    {"spawn", after.spawn - before.spawn}};
   if (transfer_before && transfer_after)
     j["line_transfer_ns"] = {{"cpus", {transfer_before->cpu_a, transfer_before->cpu_b}},

@@ -57,22 +57,22 @@ const std::vector<fishtank::BallView>& settled_tank() {
 // The timed loop of a step benchmark: the rate, and how often the lists were
 // rebuilt while it ran and what share of the time that took (a rebuild costs
 // several steps, and how often one is due depends on the scene), with what
-// the far balls' checks and each rebuild cost.
+// the strayed balls' checks and each rebuild cost.
 void time_steps(benchmark::State& state, World& world) {
-  const std::uint64_t rebuilds_before = world.rebuilds(), kept_before = world.lists_kept_far();
-  const std::uint64_t checked_before = world.far_balls_checked();
+  const std::uint64_t rebuilds_before = world.rebuilds(), kept_before = world.lists_kept_by_checks();
+  const std::uint64_t checked_before = world.strayed_balls_checked();
   const fishtank::PhaseSeconds phases_before = world.phase_seconds();
   for (auto _ : state) world.step();
   state.counters["ball_steps_per_s"] =
       benchmark::Counter(double(state.iterations()) * world.ball_count(), benchmark::Counter::kIsRate);
   const fishtank::PhaseSeconds& phases = world.phase_seconds();
   const double between_passes = phases.neighbours - phases_before.neighbours;
-  const double checks = phases.far_checks - phases_before.far_checks;
+  const double checks = phases.stray_checks - phases_before.stray_checks;
   const double steps = double(state.iterations()), rebuilds = double(world.rebuilds() - rebuilds_before);
   state.counters["rebuilds_per_kstep"] = 1000.0 * rebuilds / steps;
-  state.counters["kept_per_kstep"] = 1000.0 * double(world.lists_kept_far() - kept_before) / steps;
+  state.counters["kept_per_kstep"] = 1000.0 * double(world.lists_kept_by_checks() - kept_before) / steps;
   state.counters["rebuild_share"] = between_passes / (between_passes + phases.step_pass - phases_before.step_pass);
-  state.counters["far_per_step"] = double(world.far_balls_checked() - checked_before) / steps;
+  state.counters["far_per_step"] = double(world.strayed_balls_checked() - checked_before) / steps;
   state.counters["check_us_per_step"] = 1e6 * checks / steps;
   if (rebuilds > 0) state.counters["rebuild_us"] = 1e6 * (between_passes - checks) / rebuilds;
 }

@@ -68,7 +68,7 @@ void NeighbourList::reserve(std::uint32_t n, std::uint32_t stride, std::uint32_t
   if (lanes > 1) {
     group_records_.resize(4 * (std::size_t(n) + lanes - 1));
     group_blocks_.resize((std::size_t(n) + lanes - 1) / lanes);
-    far_rows_.resize(reach_.size());
+    remote_rows_.resize(reach_.size());
   }
 }
 
@@ -142,7 +142,7 @@ ListBuild NeighbourList::build_view(const Float4* pos, std::uint32_t n) {
   b.batch_order = batch_order_.data();
   b.reach = reach_.data();
   b.group_records = group_records_.data(), b.group_blocks = group_blocks_.data();
-  b.far_rows = far_rows_.data();
+  b.remote_rows = remote_rows_.data();
   return b;
 }
 

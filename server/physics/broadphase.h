@@ -1,26 +1,17 @@
 #pragma once
 // Broad phase: a uniform grid and a Verlet neighbour list with a skin.
 //
-//   sort():  counting sort of balls by cell. The world reorders its arrays by
-//            the result. Cells are numbered x fastest, then y, then z, inside
-//            column blocks kBlockCells wide in x (block slowest): the three
-//            cells x-1..x+1 of a row are then one contiguous index range (two
-//            at a block's edge), so nine to eighteen ranges cover all 27
-//            neighbouring cells, and a ball's neighbours one z-layer away are
-//            one block's layer away in memory, not a whole tank's. A tank at
-//            most kBlockCells wide is one block: plain x, y, z order.
-//   build:   for each ball, every other ball closer than r_i + r_j + skin
-//            (a kernel, Kernels::build_lists). Each batch of balls writes
-//            only its own stretch of the lists (the layout below), so chunks
-//            build in parallel, and lists come out the same for any thread
-//            count.
+//   sort():  counting sort of balls by cell, x fastest, then y, then z,
+//            inside column blocks kBlockCells wide in x: a row's cells
+//            x-1..x+1 are one index range, so nine to eighteen ranges cover
+//            the 27 neighbouring cells, and the next z-layer is one block's
+//            layer away in memory, not a whole tank's.
+//   build:   for each ball, every ball closer than r_i + r_j + skin
+//            (Kernels::build_lists); each batch writes only its own stretch.
 //
-// The list stays valid while no ball has moved more than skin / 2 since the
-// build (two balls closing by skin / 2 each could then touch unseen), the
-// LAMMPS criterion. Past that the world keeps it as long as the few balls
-// that moved further touch only balls in their lists (misses_contact, for as
-// long as a search is worth it: can_check): in a million-ball scene the
-// fastest balls are a thin tail, and most rebuilds were for them alone.
+// A list stays valid while no ball has moved more than skin / 2 since the
+// build (LAMMPS's criterion); past that the world keeps it while the few
+// balls that strayed further touch only balls in their lists (misses_contact).
 
 #include <algorithm>
 #include <cstddef>
@@ -36,29 +27,19 @@
 
 namespace fishtank {
 
-// The lists' layout. Balls are taken in batches of kStepBatch, which start
-// at multiples of it (every WorkerPool chunk of the world does too), and a
-// batch keeps its lists from neighbours + first * stride, packed: the batch's
-// balls in groups of `lanes` (in batch_order), each group as many blocks as
-// its longest list, a block holding the next neighbour of each ball of the
-// group, in list order, or the ghost (index n) for a list that has ended.
-// An entry is the neighbour's byte offset in the ball arrays (list_entry),
-// which an address takes with no shift: x86 scales an index by 8 at most.
-// With one lane (the scalar twin, batch order = ball order) that is each
-// ball's list after the previous ball's; with four or eight (the SIMD twins)
-// a block is one vector's neighbours, contiguous, and the batch's groups are
-// balls of similar counts (kernels_simd_ball.h). stride bounds a list's
-// length: it sizes the room, not the layout, so a batch's lists fill one
-// stretch of memory as long as they are, however large the stride.
+// The lists' layout. A batch of kStepBatch balls keeps its lists from
+// neighbours + first * stride, packed: its balls in groups of `lanes` (in
+// batch_order), each group as many blocks as its longest list, a block
+// holding the next neighbour of each ball of the group, or the ghost (index
+// n) past a list's end. With one lane (the scalar twin) that is each ball's
+// list after the previous one's; with four or eight a block is one vector's
+// neighbours. An entry is a byte offset (list_entry): an address takes it
+// with no shift, as x86 scales an index by 8 at most.
 //
-// The SIMD builds also write, per group, what the step needs of the group
-// itself, so that it reads aligned vectors instead of gathering rows into
-// lanes: a record of 32-bit words at group_records + 4 * (the group's place
-// in batch_order), four words per ball, holding the balls' positions at the
-// build axis by axis (the bits of x of every lane, then y, then z) and then
-// their list entries (write_group_record); and its number of blocks at
-// group_blocks + place / lanes. The scalar twin reads the rows and counts
-// instead.
+// The SIMD builds also write per group a record of four 32-bit words per
+// ball, at group_records + 4 * (its place in batch_order): the lanes' x at
+// the build, then y, then z, then their list entries (write_group_record),
+// so the step loads aligned vectors; and its block count at group_blocks + place / lanes.
 constexpr std::uint32_t kStepBatch = 128;
 
 // The end of the batch that holds ball `first`, within [.., end).
@@ -94,10 +75,8 @@ inline void write_group_record(const Float4* pos, const std::uint32_t* group, st
   }
 }
 
-// The balls a batch's lists name lie in [lowest, highest] (lowest > highest
-// when they name none). Batches near a chunk's edge name balls of the
-// neighbouring chunk: the world asks for those rows ahead
-// (World::add_edge_fetches).
+// The balls a batch's lists name lie in [lowest, highest] (none: lowest > highest); near a chunk's
+// edge they include the next chunk's, which the world asks for ahead (World::add_edge_fetches).
 struct BatchReach {
   std::uint32_t lowest = std::numeric_limits<std::uint32_t>::max(), highest = 0;
   void add(std::uint32_t j) {
@@ -106,14 +85,11 @@ struct BatchReach {
   }
 };
 
-// The rows a batch's lists name far from the batch in the sorted order: in
-// practice the neighbours across a column block's x faces (sort() above), a
-// whole block of balls away, where neither the rows that the SIMD step asks
-// for ahead nor those it read lately lie (kernels_simd_ball.h, is_far_row).
-// One row per cache line of rows, up to kMost: a batch that names more keeps
-// the first kMost, and the rest are only asked for late, never wrong. The
-// SIMD builds write them and the SIMD steps ask for them ahead.
-struct FarRows {
+// The rows a batch's lists name far from it in memory: in practice the
+// neighbours across a column block's x faces (sort() above), out of reach of
+// the SIMD step's prefetch ahead (kernels_simd_ball.h, is_remote_row). One row
+// per cache line, up to kMost; past that a row is only fetched late.
+struct RemoteRows {
   static constexpr std::uint32_t kMost = 31;
   static constexpr std::uint32_t kRowsPerLine = 64 / sizeof(Float4);
   std::uint32_t count = 0;
@@ -126,8 +102,7 @@ struct FarRows {
   }
 };
 
-// What a list build reads and writes: the cell-sorted balls and the grid, and
-// the lists to fill. The build itself is a kernel (kernels.h), scalar or SIMD.
+// What a list build (a kernel, kernels.h) reads and writes: the cell-sorted balls, the grid, the lists.
 struct CellCoord {
   std::int32_t x, y, z;
 };
@@ -152,7 +127,7 @@ struct ListBuild {
   BatchReach* reach;             // out, threaded builds only: per batch, the balls its stored lists name
   std::uint32_t* group_records;  // out, SIMD builds only: per group, its record (see above)
   std::uint32_t* group_blocks;   // out, SIMD builds only: per group, its number of blocks
-  FarRows* far_rows;             // out, SIMD builds only, unless null: per batch, its far rows
+  RemoteRows* remote_rows;       // out, SIMD builds only, unless null: per batch, its remote rows
 };
 
 // One ball's stored list: neighbour k is listed_index(first[k * lanes]).
@@ -163,9 +138,18 @@ struct ListView {
   std::uint32_t operator[](std::uint32_t k) const { return listed_index(first[std::size_t(k) * lanes]); }
 };
 
-// Ghost slots after the last ball: a SIMD build reads up to three balls past
-// the end of a cell range, so arrays hold n + kGhostSlots entries, each a
-// ghost parked where it touches nothing.
+// The lists of the last build as a step reads them (the layout above): with
+// one lane, `counts` says where a list ends; with more, each group's record and blocks.
+struct StepLists {
+  const std::uint32_t* neighbours = nullptr;
+  std::uint32_t stride = 0;
+  const std::uint32_t* counts = nullptr;         // one lane
+  const std::uint32_t* group_records = nullptr;  // more lanes
+  const std::uint32_t* group_blocks = nullptr;   // more lanes
+};
+
+// A SIMD build reads up to three balls past a cell range's end: arrays hold
+// n + kGhostSlots entries, the ghosts parked where they touch nothing.
 constexpr std::uint32_t kGhostSlots = 4;
 constexpr Float4 kGhostPos{1e6f, 1e6f, 1e6f, 0.0f};
 
@@ -188,14 +172,9 @@ inline AxisGaps axis_gaps(float pos, float origin, float edge, int c, int cells)
   return {c == 0 ? kNone : below * below, c + 1 == cells ? kNone : above * above};
 }
 
-// Calls visit(j_begin, j_end) for index ranges that hold every ball of the
-// 27 cells around cell c that lies within reach of a ball p (radius p.w) in
-// it: r + the largest radius + skin, so any ball closer than r + r_j + skin.
-// A neighbouring cell is skipped when its nearest point is further than
-// that, so a small ball in the middle of its cell scans a fraction of them.
-// A row's cells x-1..x+1 are one contiguous range, split where the row
-// crosses a block edge; ranges come in cell order, so the lists are the same
-// with or without the cells skipped.
+// Calls visit(j_begin, j_end) for index ranges holding every ball of the 27
+// cells around c within r + the largest radius + skin of p, skipping cells
+// beyond that reach. Ranges come in cell order, so lists do not depend on the skipping.
 template <class Visit>
 inline void for_each_range_within_reach(const ListBuild& b, CellCoord c, Float4 p, Visit visit) {
   // The margin covers the rounding of the cells' assignment (sort()).
@@ -243,28 +222,18 @@ class NeighbourList {
   // Fills order[new] = old for the n balls at pos.
   void sort(const Float4* pos, std::uint32_t n, std::vector<std::uint32_t>& order);
 
-  // What a build of the lists for the n sorted balls at pos needs (see
-  // Kernels::build_lists). A list longer than stride() is cut short and its
-  // count says so: the caller then grows the stride and builds again.
+  // What a build of the lists for the n sorted balls at pos needs. A list longer than stride() is cut
+  // short and its count says so: the caller then grows the stride and builds again.
   ListBuild build_view(const Float4* pos, std::uint32_t n);
 
-  // Whether ball i, now at pos[i], touches a ball that its list lacks: one
-  // whose position at the last build (at_build) was beyond the list's reach.
-  // `moved` is the furthest any ball has moved since that build: a ball that
-  // touches i now was then within r_i + the largest radius + moved of where i
-  // is now, and the search covers the build's cells that far around it, as
-  // many as that takes. The world checks this for the few balls that moved
-  // more than skin / 2 instead of rebuilding for them (world.cpp,
-  // lists_hold()). Also true past can_check.
+  // Whether ball i, now at pos[i], touches a ball its list lacks. `moved` is the furthest any ball
+  // moved since the build, so the search covers the build's cells that far around i. True past can_check.
   bool misses_contact(std::uint32_t i, const Float4* pos, const Float4* at_build, float moved) const;
-  // Whether a check after balls moved up to `moved` is worth it: while a large
-  // ball's search reaches at most kMaxCheckCells cells past its own on every
-  // side, so that a check costs a few list builds' candidates at most, not a
-  // box of cells growing with the cube of the distance.
+  // Whether a check is worth it: while a large ball's search reaches at most kMaxCheckCells cells
+  // past its own, its cost stays that of a few list builds, not growing with the cube of `moved`.
   bool can_check(float moved) const;
 
-  // Room for `stride` neighbours of each of n balls, laid out in groups of
-  // `lanes` (Kernels::list_lanes of the build that fills them).
+  // Room for `stride` neighbours of each of n balls, in groups of `lanes` (Kernels::list_lanes).
   void reserve(std::uint32_t n, std::uint32_t stride, std::uint32_t lanes);
 
   std::uint32_t stride() const { return stride_; }
@@ -274,7 +243,13 @@ class NeighbourList {
   const BatchReach* batch_reach() const { return reach_.data(); }
   const std::uint32_t* group_records() const { return group_records_.data(); }
   const std::uint32_t* group_blocks() const { return group_blocks_.data(); }
-  const FarRows* far_rows() const { return far_rows_.data(); }
+  StepLists step_lists() const {
+    StepLists l;
+    l.neighbours = neighbours(), l.stride = stride_, l.counts = counts();
+    l.group_records = group_records(), l.group_blocks = group_blocks();
+    return l;
+  }
+  const RemoteRows* remote_rows() const { return remote_rows_.data(); }
 
   // Calls visit(i, ListView) once for each ball of the last build, batch by
   // batch in the layout's order.
@@ -303,9 +278,7 @@ class NeighbourList {
   std::uint32_t stride_ = 0;
   std::uint32_t lanes_ = 1;
   std::uint32_t listed_balls_ = 0;  // n of the last build_view
-  // Room for the lists, left uninitialised: a build writes only what the lists
-  // take (about a quarter of the room at the default stride), and pages never
-  // written are never mapped.
+  // Left uninitialised: a build writes only what the lists take, and pages never written are never mapped.
   std::unique_ptr<std::uint32_t[]> neighbours_;
   std::size_t neighbours_room_ = 0;
   std::vector<std::uint32_t> counts_;
@@ -313,7 +286,7 @@ class NeighbourList {
   std::vector<BatchReach> reach_;
   AlignedVector<std::uint32_t> group_records_;  // SIMD builds only
   std::vector<std::uint32_t> group_blocks_;     // SIMD builds only
-  std::vector<FarRows> far_rows_;               // SIMD builds only
+  std::vector<RemoteRows> remote_rows_;         // SIMD builds only
   AlignedVector<float> axes_;                   // x, y, z, radius of the sorted balls, axis by axis (ListBuild)
 };
 

@@ -3,21 +3,15 @@
 // twins with the same signatures:
 //   kernels_scalar.cpp  plain C++, one pair at a time (the reference)
 //   kernels_sse.cpp     SSE4.1, four balls and one neighbour of each at a time
-//   kernels_avx2.cpp    AVX2 + FMA, eight balls and one neighbour of each at a time (a third level)
-// The two SIMD files share their passes, written once for either vector
-// type (kernels_simd_ball.h); each says how to gather and scatter its lanes.
-// A build picks one set at compile time (see server/main.cpp); the tests hold
-// them all so they can compare them.
+//   kernels_avx2.cpp    AVX2 + FMA, eight balls at a time (a third level)
+// The SIMD passes are written once for either vector (kernels_simd_ball.h).
 //
-// Velocity Verlet in one pass over the balls per step. Positions and
-// half-step velocities are double-buffered: the pass reads this step's
+// Velocity Verlet in one pass per step, double-buffered: the pass reads
 // (pos, vel_half) of ball i and its neighbours and writes only ball i's
 // outputs, so chunks run in parallel with no races and no atomics:
 //   a    = F(pos, vel_half) / m + g
 //   v    = vel_half + a dt/2                 (the full step, not stored)
 //   vel_half_next = v + a dt/2,  pos_next = pos + vel_half_next dt
-// Observers' full-step velocity is the mean of vel_half and vel_half_next,
-// derived when someone asks (World::velocities).
 
 #include <cstdint>
 #include <limits>
@@ -28,64 +22,47 @@
 
 namespace fishtank {
 
-// Rows [rows_begin, rows_end) of this step's pos and vel_half, for the SIMD
-// step to ask for while it runs batches first_batch..end_batch - 1 (numbered
-// by ball / kStepBatch), each group its share of the cache lines.
+// The arrays every twin's step reads and writes.
+struct StepArrays {
+  const Float4* pos = nullptr;  // x, y, z, radius at this step
+  // vx, vy, vz, 1 / mass half a step before: F / m becomes a product, and a
+  // pair's effective mass 1 / (1/m1 + 1/m2) one sum.
+  const Float4* vel_half = nullptr;
+  Float4* pos_next = nullptr;            // out: position one step later
+  Float4* vel_half_next = nullptr;       // out: velocity half a step later
+  const Float4* pos_at_build = nullptr;  // where the lists were built (the SIMD twins read the group records)
+  StepLists lists;                       // full lists, each pair from both sides (broadphase.h)
+  const Float4* player_pos = nullptr;    // x, y, z, radius
+  const Float4* player_vel = nullptr;    // vx, vy, vz, 0: a kinematic body's inverse mass
+  int players = 0;
+  // Balls whose pos_next lies further than sqrt(stray_d2) from pos_at_build
+  // have strayed: chunk [begin, end) lists its own, each once, at
+  // stray_balls + begin, for the world to check (World::lists_hold).
+  float stray_d2 = std::numeric_limits<float>::infinity();
+  std::uint32_t* stray_balls = nullptr;
+};
+
+// Rows [rows_begin, rows_end) of pos and vel_half, asked for while batches
+// [first_batch, end_batch) run (numbered by ball / kStepBatch).
 struct RowFetch {
   std::uint32_t rows_begin = 0, rows_end = 0;
   std::uint32_t first_batch = 0, end_batch = 0;
 };
 
-struct StepArrays {
-  const Float4* pos;  // x, y, z, radius at this step
-  // vx, vy, vz, 1 / mass: velocity half a step before. The inverse mass, as
-  // both uses need it: F / m becomes a product, and a pair's effective mass
-  // m1 m2 / (m1 + m2) = 1 / (1/m1 + 1/m2) needs one sum.
-  const Float4* vel_half;
-  Float4* pos_next;       // out: position one step later
-  Float4* vel_half_next;  // out: velocity half a step later
-  const Float4* pos_at_build;
-  // Full neighbour lists (each pair appears from both sides), as this
-  // kernel set's build laid them out (broadphase.h); no count exceeds stride.
-  const std::uint32_t* neighbours;
-  const std::uint32_t* neighbour_count;
-  std::uint32_t stride;
-  // The SIMD builds' per-group records and block counts (broadphase.h): the
-  // SIMD steps read these instead of the counts and pos_at_build; the scalar
-  // twin, which has no groups, reads those.
-  const std::uint32_t* group_records;
-  const std::uint32_t* group_blocks;
-  const Float4* player_pos;  // x, y, z, radius
-  const Float4* player_vel;  // vx, vy, vz, 0
-  int players;
-  // Whether the arrays outgrow the caches, so that the SIMD kernels ask for
-  // rows a few batches ahead (kernels_simd_ball.h, prefetch_batch_ahead).
-  bool beyond_cache = false;
-  // Per batch of balls (numbered by ball / kStepBatch, `batches` of them),
-  // the rows its lists name far away (broadphase.h), which the SIMD steps ask
-  // for ahead too when beyond_cache; the scalar twin ignores them.
-  const FarRows* far_rows = nullptr;
+// What a SIMD step asks memory for ahead of use (kernels_simd_ball.h). Results
+// never depend on it; the scalar twin reads its rows in order and takes none.
+struct PrefetchPlan {
+  bool beyond_cache = false;                // ask for rows kPrefetchBatches ahead, and the remote rows
+  const RemoteRows* remote_rows = nullptr;  // per batch, `batches` of them
   std::uint32_t batches = 0;
-  // A ball whose pos_next is further than sqrt(far_d2) from pos_at_build is
-  // "far": the step of chunk [begin, end) lists its far balls, each once, at
-  // far_balls + begin, for the world to check them one by one
-  // (World::lists_hold). The default lists none.
-  float far_d2 = std::numeric_limits<float>::infinity();
-  std::uint32_t* far_balls = nullptr;
-  // The rows at a chunk's edges that another thread's batches read too
-  // (World::add_edge_fetches); none by default. The scalar twin runs on one
-  // thread, with no edges, and ignores them.
-  RowFetch edge_fetch[2] = {};
-  // The batches [lead_begin, lead_end) of the chunk (ball indices) run first,
-  // then the others in order: the rows of edge_fetch's first window arrive
-  // while they run. None by default; the scalar twin ignores it too.
-  std::uint32_t lead_begin = 0, lead_end = 0;
+  RowFetch edge_fetch[2] = {};                 // rows that the neighbouring chunks' threads write or read too
+  std::uint32_t lead_begin = 0, lead_end = 0;  // batches run first, while edge_fetch[0] arrives
 };
 
 // How far the balls of a chunk moved from where the lists were built.
 struct Moved {
-  float max_d2 = 0.0f;    // the largest squared distance of pos_next from pos_at_build
-  std::uint32_t far = 0;  // balls beyond StepArrays::far_d2, listed at far_balls + begin
+  float max_d2 = 0.0f;        // the largest squared distance of pos_next from pos_at_build
+  std::uint32_t strayed = 0;  // balls beyond StepArrays::stray_d2, listed at stray_balls + begin
 };
 
 struct Kernels {
@@ -93,27 +70,19 @@ struct Kernels {
   const char* simd;          // instruction set of the kernels
   bool threaded;             // whether the build may use more than one thread
   std::uint32_t list_lanes;  // balls per group in the lists' layout (broadphase.h)
-  // Each pass takes balls [begin, end), where begin is a multiple of
-  // kStepBatch and end is one too or the last ball's index + 1, as in every
-  // WorkerPool chunk of the world: the lists are laid out per batch.
-  //
-  // The step. Returns how far the balls moved from where the lists were
-  // built, which tells when they must be rebuilt.
-  Moved (*step)(const StepArrays& s, const ContactModel& m, std::uint32_t begin, std::uint32_t end);
-  // a = F(pos, vel_half) / m + g only, into acc: for a state whose forces are
-  // not known yet (balls placed in contact). Writes none of s's outputs.
+  // Each pass takes balls [begin, end) from batch edges (kStepBatch): the lists are laid out per batch.
+  // The step returns how far the balls moved since the build, which says when to rebuild.
+  Moved (*step)(const StepArrays& s, const PrefetchPlan& plan, const ContactModel& m, std::uint32_t begin,
+                std::uint32_t end);
+  // a = F(pos, vel_half) / m + g only, into acc: for balls placed in contact, whose forces are not known yet.
   void (*accelerations)(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin,
                         std::uint32_t end);
   // Neighbour lists (see broadphase.h). Returns the longest.
   std::uint32_t (*build_lists)(const ListBuild& b, std::uint32_t begin, std::uint32_t end);
 };
 
-// The second half of a step for one ball, in plain C++: the half kick from
-// the full-step velocity v with acceleration a, then the drift from p into
-// vel_half_next and pos_next (v's w, which must be 1 / mass, goes with it).
-// Returns the squared distance of pos_next from
-// at_build. The scalar step kernel uses it, and so does the world for balls
-// whose acceleration it computes itself (spawned, or placed in contact).
+// One ball's half kick from full-step velocity v (w: 1 / mass) and drift from p; returns the squared
+// distance of pos_next from at_build. The scalar step and the world's spawned or placed balls share it.
 inline float kick_drift(const ContactModel& m, const Float4& v, const Float4& p, const Float4& a,
                         const Float4& at_build, Float4& vel_half_next, Float4& pos_next) {
   const Float4 vh{v.x + a.x * m.half_dt, v.y + a.y * m.half_dt, v.z + a.z * m.half_dt, v.w};

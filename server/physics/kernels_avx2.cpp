@@ -1,12 +1,6 @@
-// AVX2 + FMA level of the step kernels: eight balls per vector, one per lane,
-// and one neighbour of each per block (kernels_simd_ball.h), with fused
-// multiply-adds. See kernels.h for the passes and kernels_scalar.cpp for the
-// same arithmetic one pair at a time.
-//
-// AVX's shuffles work within 128-bit halves, so lanes l and l + 4 come from
-// one paired load and the SSE 4x4 transpose serves both halves at once.
-// Fused multiply-adds round once where the other variants round twice, so
-// states agree with them to float rounding, not bit for bit.
+// AVX2 + FMA level of the step kernels: eight balls per vector, one neighbour
+// of each per block (kernels_simd_ball.h). Fused multiply-adds round once
+// where the other variants round twice: states agree to float rounding.
 
 #include "common/simd/avx_float8.h"
 #include "server/physics/kernels_simd_ball.h"
@@ -19,7 +13,7 @@ using simd::F8;
 template <>
 struct Lanes<F8> {
   static constexpr std::uint32_t kCount = 8;
-  // Ball at[l] in lane l of the low half, at[l + 4] in lane l of the high half.
+  // AVX shuffles stay within 128-bit halves: at[l] goes to lane l of the low half, at[l + 4] of the high.
   static void load(const Float4* rows, const std::uint32_t* at, F8& x, F8& y, F8& z, F8& w) {
     simd::transpose(F8::load_pair(listed(rows, at[0]), listed(rows, at[4])),
                     F8::load_pair(listed(rows, at[1]), listed(rows, at[5])),

@@ -9,12 +9,10 @@
 namespace fishtank {
 namespace {
 
-// Spring-dashpot force on a ball along unit normal n (pointing towards the
-// ball): k x - c v_n, with v_n the ball's velocity relative to the other body
-// projected on n, and c from the pair's effective mass, whose inverse is the
-// sum of the two inverse masses (a kinematic body's is 0).
-inline float normal_force(const ContactModel& m, float overlap, float v_n, float inv_m_eff) {
-  return m.k * overlap - m.damping_factor / std::sqrt(inv_m_eff) * v_n;
+// k x - c v_n along the normal: c from the pair's effective mass, whose
+// inverse is the sum of the two inverse masses (a kinematic body's is 0).
+inline float normal_force(const ContactModel& m, float overlap, float v_n, float inv_m_sum) {
+  return m.k * overlap - m.damping_factor / std::sqrt(inv_m_sum) * v_n;
 }
 
 // Walls are half-spaces: the force keeps growing however deep the ball is.
@@ -27,29 +25,30 @@ inline float wall_force_1d(const ContactModel& m, float pos, float vel, float r,
   return f;
 }
 
-// The spring-dashpot force on ball i (position pi, half-step velocity vi)
-// from ball j, zero unless they touch.
+// The spring-dashpot force on ball i from body j (a ball, or a player sphere
+// with inverse mass 0), zero unless they touch. d points from i to j, and v_n
+// is the rate at which the gap opens; the force pushes i back along -d.
 inline Float4 contact_force(const ContactModel& m, const Float4& pi, const Float4& vi, const Float4& pj,
                             const Float4& vj) {
-  const float dx = pi.x - pj.x, dy = pi.y - pj.y, dz = pi.z - pj.z;
+  const float dx = pj.x - pi.x, dy = pj.y - pi.y, dz = pj.z - pi.z;
   const float d2 = dx * dx + dy * dy + dz * dz;
   const float reach = pi.w + pj.w;
   if (d2 >= reach * reach) return Float4{};
   const float dist = std::max(std::sqrt(d2), 1e-6f);
   const float inv_dist = 1.0f / dist;
   const float nx = dx * inv_dist, ny = dy * inv_dist, nz = dz * inv_dist;
-  const float v_n = (vi.x - vj.x) * nx + (vi.y - vj.y) * ny + (vi.z - vj.z) * nz;
+  const float v_n = (vj.x - vi.x) * nx + (vj.y - vi.y) * ny + (vj.z - vi.z) * nz;
   const float f = normal_force(m, reach - dist, v_n, vi.w + vj.w);
-  return Float4{f * nx, f * ny, f * nz, 0.0f};
+  return Float4{-f * nx, -f * ny, -f * nz, 0.0f};
 }
 
-// Sum of the spring-dashpot forces of ball i's neighbours, (Fx, Fy, Fz, 0).
-[[gnu::always_inline]] inline Float4 pair_forces(const StepArrays& s, const ContactModel& m, std::uint32_t i,
-                                                 const std::uint32_t* list) {
+// The sum of the contact forces of ball i's neighbours, in list order.
+[[gnu::always_inline]] inline Float4 neighbour_forces(const StepArrays& s, const ContactModel& m, std::uint32_t i,
+                                                      const std::uint32_t* list) {
   const Float4 pi = s.pos[i];
   const Float4 vi = s.vel_half[i];
   float fx = 0.0f, fy = 0.0f, fz = 0.0f;
-  for (std::uint32_t n = 0; n < s.neighbour_count[i]; ++n) {
+  for (std::uint32_t n = 0; n < s.lists.counts[i]; ++n) {
     const Float4 f = contact_force(m, pi, vi, listed(s.pos, list[n]), listed(s.vel_half, list[n]));
     fx += f.x;
     fy += f.y;
@@ -58,59 +57,47 @@ inline Float4 contact_force(const ContactModel& m, const Float4& pi, const Float
   return Float4{fx, fy, fz, 0.0f};
 }
 
-// a = F / m + g for ball i, given the sum of its neighbours' forces: adds
-// player spheres and walls. vel_half's w is 1 / m, so F / m is a product.
+// a = F / m + g for ball i: its neighbours' forces f, plus player spheres and walls.
 [[gnu::always_inline]] inline Float4 acceleration(const StepArrays& s, const ContactModel& m, std::uint32_t i,
-                                                  const Float4& pair_force) {
+                                                  const Float4& f) {
   const Float4 pi = s.pos[i];
   const Float4 vi = s.vel_half[i];
-  float fx = pair_force.x, fy = pair_force.y, fz = pair_force.z;
-
+  float fx = f.x, fy = f.y, fz = f.z;
   for (int p = 0; p < s.players; ++p) {
-    const Float4& pp = s.player_pos[p];
-    const Float4& pv = s.player_vel[p];
-    float dx = pi.x - pp.x, dy = pi.y - pp.y, dz = pi.z - pp.z;
-    float d2 = dx * dx + dy * dy + dz * dz;
-    float reach = pi.w + pp.w;
-    if (d2 >= reach * reach) continue;
-    float dist = std::max(std::sqrt(d2), 1e-6f);
-    float inv_dist = 1.0f / dist;
-    float nx = dx * inv_dist, ny = dy * inv_dist, nz = dz * inv_dist;
-    float v_n = (vi.x - pv.x) * nx + (vi.y - pv.y) * ny + (vi.z - pv.z) * nz;
-    float f = normal_force(m, reach - dist, v_n, vi.w);
-    fx += f * nx;
-    fy += f * ny;
-    fz += f * nz;
+    const Float4 fp = contact_force(m, pi, vi, s.player_pos[p], s.player_vel[p]);
+    fx += fp.x;
+    fy += fp.y;
+    fz += fp.z;
   }
-
   fx += wall_force_1d(m, pi.x, vi.x, pi.w, vi.w, m.tank.min.x, m.tank.max.x);
   fy += wall_force_1d(m, pi.y, vi.y, pi.w, vi.w, m.tank.min.y, m.tank.max.y);
   fz += wall_force_1d(m, pi.z, vi.z, pi.w, vi.w, m.tank.min.z, m.tank.max.z);
   return Float4{fx * vi.w, fy * vi.w - m.gravity, fz * vi.w, 0.0f};
 }
 
-Moved step(const StepArrays& arrays, const ContactModel& model, std::uint32_t begin, std::uint32_t end) {
+// One pair at a time reads its rows in order: the prefetch plan is the SIMD twins'.
+Moved step(const StepArrays& arrays, const PrefetchPlan&, const ContactModel& model, std::uint32_t begin,
+           std::uint32_t end) {
   // Local copies: stores through the output pointers cannot change them, so
-  // pointers and constants stay in registers instead of being reloaded per ball.
+  // pointers and constants stay in registers.
   const StepArrays s = arrays;
   const ContactModel m = model;
   Moved moved;
-  // The neighbour sums of a batch, then the rest per ball: one loop doing both
-  // keeps the wall and integration values live across the neighbour loop.
+  // A batch's neighbour sums first, then the rest per ball: one loop doing
+  // both keeps the wall and integration values live across the neighbour loop.
   Float4 pair_force[kStepBatch];
   for (std::uint32_t batch = begin, last_of_batch; batch < end; batch = last_of_batch) {
     last_of_batch = batch_end(batch, end);
-    // With one lane, a batch's lists follow each other (broadphase.h).
-    const std::uint32_t* list = s.neighbours + std::size_t(batch) * s.stride;
-    for (std::uint32_t i = batch; i < last_of_batch; list += s.neighbour_count[i++])
-      pair_force[i - batch] = pair_forces(s, m, i, list);
+    const std::uint32_t* list = s.lists.neighbours + std::size_t(batch) * s.lists.stride;
+    for (std::uint32_t i = batch; i < last_of_batch; list += s.lists.counts[i++])
+      pair_force[i - batch] = neighbour_forces(s, m, i, list);
     for (std::uint32_t i = batch; i < last_of_batch; ++i) {
       const Float4 a = acceleration(s, m, i, pair_force[i - batch]);
       const Float4 vh = s.vel_half[i];
       const Float4 v{vh.x + a.x * m.half_dt, vh.y + a.y * m.half_dt, vh.z + a.z * m.half_dt, vh.w};
       const float d2 = kick_drift(m, v, s.pos[i], a, s.pos_at_build[i], s.vel_half_next[i], s.pos_next[i]);
       moved.max_d2 = std::max(moved.max_d2, d2);
-      if (d2 > s.far_d2) s.far_balls[begin + moved.far++] = i;
+      if (d2 > s.stray_d2) s.stray_balls[begin + moved.strayed++] = i;
     }
   }
   return moved;
@@ -118,9 +105,9 @@ Moved step(const StepArrays& arrays, const ContactModel& model, std::uint32_t be
 
 void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin, std::uint32_t end) {
   for (std::uint32_t batch = begin; batch < end; batch += kStepBatch) {
-    const std::uint32_t* list = s.neighbours + std::size_t(batch) * s.stride;
-    for (std::uint32_t i = batch; i < batch_end(batch, end); list += s.neighbour_count[i++])
-      acc[i] = acceleration(s, m, i, pair_forces(s, m, i, list));
+    const std::uint32_t* list = s.lists.neighbours + std::size_t(batch) * s.lists.stride;
+    for (std::uint32_t i = batch; i < batch_end(batch, end); list += s.lists.counts[i++])
+      acc[i] = acceleration(s, m, i, neighbour_forces(s, m, i, list));
   }
 }
 

@@ -1,17 +1,7 @@
-// SSE4.1 twin of the step kernels: four balls per vector, one per lane, and
-// one neighbour of each per block (kernels_simd_ball.h). See kernels.h for the
-// passes and kernels_scalar.cpp for the same arithmetic one pair at a time.
-//
-// Against one ball's neighbours four at a time, this needs no sums over lanes,
-// adds each ball's forces in list order as the scalar twin does, and serves
-// four balls per instruction in walls, kick and drift; grouped by list
-// length, its blocks are as full, and the blocks in which no lane touches
-// need no force (on the settled tank 1.91 blocks of four per ball, 1.61 of
-// them with a force, against 2.21 blocks for one ball's neighbours four at a
-// time: technical report, section 4). 1/|d| comes from the
-// reciprocal-square-root estimate plus a Newton step (1e-7 relative) instead
-// of sqrt and divide, which the scalar twin uses, so the twins agree to float
-// rounding, not bit for bit.
+// SSE4.1 twin of the step kernels: four balls per vector, one neighbour of
+// each per block (kernels_simd_ball.h). Four balls rather than one ball's four
+// neighbours: no sums across lanes, forces added in the scalar twin's order.
+// 1/|d| is an estimate with a Newton step, so the twins agree to float rounding.
 
 #include "server/physics/kernels_simd_ball.h"
 

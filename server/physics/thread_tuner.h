@@ -1,16 +1,11 @@
 #pragma once
 // Picks how many worker threads a world steps with, by measurement.
 //
-// On a quiet machine every core helps. On a busy one a worker the OS
-// preempts inside its chunk holds up the whole pass until it runs again, and
-// paced steps start after the workers have slept: then one thread can step
-// faster than all. The balance moves from moment to moment, so the tuner
-// keeps a running estimate of the cost of a step on every thread and on one,
-// steps with the cheaper, and now and then times a few steps with the other
-// (a probe). Each estimate forgets with a time constant of kTimeConstant
-// seconds, so a change of load changes the choice within about half a second.
-// Results never depend on the thread count (the state is bit-identical), so
-// switching is invisible except in the speed.
+// On a busy machine a preempted worker holds up its pass, and one thread can
+// step faster than all. So the tuner keeps a running cost estimate of a step
+// on every thread and on one (time constant kTimeConstant), steps with the
+// cheaper, and now and then times a few steps with the other (a probe).
+// Results never depend on the thread count: switching shows only in speed.
 
 #include <cstdint>
 
@@ -26,10 +21,7 @@ class ThreadTuner {
   static constexpr double kMaxProbeBackoff = 5.0;
   // A probe lasts until it has measured this much stepping.
   static constexpr double kProbeBusySeconds = 0.001;
-  // The other count must be this much cheaper to be chosen, so that two
-  // nearly equal estimates do not swap the choice back and forth. Going to
-  // every thread asks for more: on a busy machine their cost varies widely
-  // (a preempted worker stalls a pass), one thread's does not.
+  // Hysteresis against swapping back and forth; more to go to every thread, whose cost varies more.
   static constexpr double kHysteresisToOne = 0.05;
   static constexpr double kHysteresisToAll = 0.15;
 

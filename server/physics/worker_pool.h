@@ -5,20 +5,13 @@
 //        │ claims chunks                                 each claims chunks
 //        └──────── waits until every chunk is done ◄─────────┘
 //
-// A phase's items are cut into a few chunks per thread, and each thread owns
-// a contiguous run of them, so on a quiet machine every thread streams
-// through the same part of the arrays pass after pass. A thread that has
-// finished its own chunks takes unstarted ones from the back of the others'
-// runs. So a thread the OS has not scheduled (a busy machine) or that runs
-// slowly (a core shared on the host) never holds up a pass beyond the chunk it
-// is inside: the caller finishes the rest. Every claim carries the phase's
-// generation, so a worker that wakes late cannot take a later phase's chunk
-// for its own.
-//
-// Chunks start at multiples of a granule, and results never depend on which
-// thread computes a chunk: each item is computed by exactly one thread, the
-// same way. With one thread, or too few items to be worth splitting, run() is
-// a plain call with no synchronisation at all.
+// Each thread owns a contiguous run of a few chunks, so on a quiet machine it
+// streams through the same arrays pass after pass; a thread done with its own
+// takes unstarted chunks from the back of the others' runs, so a thread the OS
+// has not scheduled holds up a pass by at most the chunk it is inside. Claims
+// carry the phase's generation: a late worker cannot take a later phase's chunk.
+// Each item is computed by exactly one thread, the same way: results never
+// depend on the thread count.
 
 #include <atomic>
 #include <boost/thread/condition_variable.hpp>
@@ -48,32 +41,26 @@ class WorkerPool {
   int active_limit() const { return active_limit_; }
   // Runs phase on `count` items, in chunks claimed by the active threads.
   void run(std::uint32_t count, const Phase& phase);
-  // For items that each cost as much as hundreds of balls' steps (a moved
-  // ball's check): splits from `min_per_thread` items per thread, in chunks
-  // of any length.
+  // For costly items (a strayed ball's check): split from `min_per_thread` per thread, any chunk length.
   void run_costly(std::uint32_t count, std::uint32_t min_per_thread, const Phase& phase);
   // Each thread's fraction of the items computed since the last reset_shares()
   // (or construction), one entry per thread.
   std::vector<double> shares() const;
   void reset_shares();
-  // Wakes sleeping workers now so that they are polling, not asleep, when a
-  // run() comes within the next millisecond: a paced caller pays the wake-up
-  // while it waits for its next batch instead of inside the batch.
+  // Wakes sleeping workers so they poll when a run() comes soon: a paced caller pays the wake-up
+  // while it waits, not inside its batch.
   void wake();
-  // For tests: called on a worker thread when it picks up a phase, before it
-  // claims a chunk (to stall it on purpose). Set before the first run.
+  // For tests: called on a worker as it picks up a phase, to stall it on purpose. Set before the first run.
   void set_worker_hook(std::function<void(int thread)> hook) { worker_hook_ = std::move(hook); }
 
   // The run-time default: one thread per available core.
   static int hardware_threads();
 
  private:
-  // Few enough that claiming costs nothing next to a chunk, enough that the
-  // caller's share of a stalled thread's work comes in small pieces.
+  // Few enough that claiming is cheap, enough that a stalled thread's work is taken in small pieces.
   static constexpr int kChunksPerThread = 4;
 
-  // A thread's unclaimed chunks [front, back) in the phase of generation
-  // `tag`, packed in one word so that a claim is a single compare-and-swap.
+  // A thread's unclaimed chunks [front, back) of generation `tag`: one word, so a claim is one CAS.
   struct alignas(64) Claims {
     std::atomic<std::uint64_t> word{0};
   };
@@ -82,8 +69,7 @@ class WorkerPool {
   };
 
   void worker_loop(int thread);
-  // Runs chunks until none is left: the thread's own from the front, then the
-  // others' from the back, of the phase of `generation`.
+  // Runs chunks until none is left: the thread's own from the front, then the others' from the back.
   void work(int thread, std::uint64_t generation);
   int claim(int owner, bool from_front, std::uint32_t tag);
   void run(std::uint32_t count, const Phase& phase, std::uint32_t granule, std::uint32_t min_per_thread);

@@ -16,8 +16,7 @@ namespace {
 constexpr float kPackingLimit = 0.6f;
 constexpr Float4 kGhostVel{0.0f, 0.0f, 0.0f, 1.0f};  // mass 1: the same as vel_ and as a half-step row
 
-// vel_ carries each ball's mass, as observers expect; the kernels' half-step
-// rows carry 1 / mass (StepArrays::vel_half).
+// vel_ carries each ball's mass, as observers expect; the kernels' half-step rows carry 1 / mass.
 Float4 half_step_row(const Float4& vel) { return {vel.x, vel.y, vel.z, 1.0f / vel.w}; }
 
 class PhaseTimer {
@@ -59,7 +58,7 @@ void World::resize(std::uint32_t n) {
     v->resize(n + kGhostSlots);
   kind_.resize(n);
   id_.resize(n);
-  far_balls_.resize(n);
+  stray_balls_.resize(n);
   set_ghost();
 }
 
@@ -171,8 +170,7 @@ void World::spawn() {
     kind_[i] = static_cast<std::uint8_t>(placed_[b].kind);
     id_[i] = next_id_++;
     energy_added_ += ball_energy(pos_[i], vel_[i], model_.gravity);
-    // A spawned ball touches nothing, so gravity is its whole acceleration.
-    // (Its distance from a build it was never in means nothing: the lists are rebuilt anyway.)
+    // A spawned ball touches nothing, so gravity is its whole acceleration (and the lists are rebuilt).
     kick_drift(i, Float4{0.0f, -model_.gravity, 0.0f, 0.0f});
   }
   needs_rebuild_ = true;
@@ -185,15 +183,14 @@ void World::rebuild() {
   needs_rebuild_ = false;
   ++rebuilds_;
   built_at_step_ = steps_;
-  far_checked_at_build_ = far_checked_;
+  strayed_checked_at_build_ = strayed_checked_;
 }
 
 void World::sort_and_reorder() {
   PhaseTimer timer(phase_seconds_.sort);
   list_.sort(pos_.data(), n_, order_);
-  // Gather every per-ball array into cell order, in parallel. The next-step
-  // buffers and acc_ are free here (the pass that follows rewrites them), so
-  // they take the gathered copies and then swap places with the originals.
+  // Gathered in parallel into the next-step buffers and acc_, free here (the next pass rewrites them),
+  // which then swap places with the originals.
   kind_scratch_.resize(kind_.size());
   id_scratch_.resize(id_.size());
   pool_.run(n_, [this](std::uint32_t begin, std::uint32_t end, int) {
@@ -221,7 +218,7 @@ void World::build_lists() {
     list_.reserve(n_, list_.stride(), kernels_.list_lanes);
     std::fill(chunk_longest_.begin(), chunk_longest_.end(), 0u);
     ListBuild build = list_.build_view(pos_.data(), n_);
-    if (!beyond_cache()) build.far_rows = nullptr;  // the step asks for nothing ahead
+    if (!beyond_cache()) build.remote_rows = nullptr;  // the step asks for nothing ahead
     pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int chunk) {
       chunk_longest_[chunk] = kernels_.build_lists(build, begin, end);
     });
@@ -232,51 +229,39 @@ void World::build_lists() {
 }
 
 StepArrays World::arrays() {
-  return StepArrays{pos_.data(),
-                    vel_half_.data(),
-                    pos_next_.data(),
-                    vel_half_next_.data(),
-                    pos_at_build_.data(),
-                    list_.neighbours(),
-                    list_.counts(),
-                    list_.stride(),
-                    list_.group_records(),
-                    list_.group_blocks(),
-                    player_pos_.data(),
-                    player_vel_.data(),
-                    static_cast<int>(player_pos_.size()),
-                    beyond_cache(),
-                    list_.far_rows(),
-                    (n_ + kStepBatch - 1) / kStepBatch};
+  StepArrays s;
+  s.pos = pos_.data();
+  s.vel_half = vel_half_.data();
+  s.pos_next = pos_next_.data();
+  s.vel_half_next = vel_half_next_.data();
+  s.pos_at_build = pos_at_build_.data();
+  s.lists = list_.step_lists();
+  s.player_pos = player_pos_.data();
+  s.player_vel = player_vel_.data();
+  s.players = static_cast<int>(player_pos_.size());
+  return s;
 }
 
-// Neighbouring chunks' threads read each other's edge rows every step, and
-// this machine's cores pass a cache line in ~225 ns one way in the phases
-// when the host places them far apart (~85 ns in others). Timing each batch
-// of a two-thread step in such a phase showed the cost landing on the rows'
-// own thread too: the batches of the lower chunk that read its last rows,
-// which the upper thread had read at the start of the step, took 37-120 %
-// longer (a line one core wrote and another then read comes back to the
-// first at the price of a transfer). So each chunk asks for its edge rows
-// ahead, while batches that do not need them yet run, and the transfers
-// overlap instead of stalling the batches one miss at a time (technical
-// report, 6.1):
-//  - below its first ball: the rows its first batches read, written by the
-//    thread below at the end of its last step, at once, while the chunk
-//    runs first the two batches after those that read them;
-//  - around its last ball: its own rows that the thread above reads, and
-//    the rows above that it reads itself, over the few batches before the
-//    first one that reads them.
-// A range larger than a few rows per ball of its window (a chunk edge across
-// the grid's column blocks, in the wide scene, where an edge is a small part
-// of a chunk anyway) is left to the hardware.
-void World::add_edge_fetches(StepArrays& s, std::uint32_t begin, std::uint32_t end) const {
-  constexpr std::uint32_t kBelowWindow = 2, kAboveWindow = 4;  // batches; measured flat from 1 to 6
+PrefetchPlan World::prefetch_plan() const {
+  PrefetchPlan plan;
+  plan.beyond_cache = beyond_cache();
+  plan.remote_rows = list_.remote_rows();
+  plan.batches = (n_ + kStepBatch - 1) / kStepBatch;
+  return plan;
+}
+
+// Neighbouring chunks' threads read each other's edge rows, and each such line
+// comes by a transfer between cores. So a chunk asks for them ahead, while
+// batches that do not need them run: the rows below its first ball at once
+// (running first the batches after those that read them), the rows around
+// its last ball over the few batches before. Larger ranges are left to the hardware.
+void World::add_edge_fetches(PrefetchPlan& plan, std::uint32_t begin, std::uint32_t end) const {
+  constexpr std::uint32_t kBelowWindow = 2, kAboveWindow = 4;  // batches
   constexpr std::uint32_t kMostRowsPerBall = 4;
   const BatchReach* reach = list_.batch_reach();
   const std::uint32_t first = begin / kStepBatch, last = (end + kStepBatch - 1) / kStepBatch;
   const std::uint32_t batches = (n_ + kStepBatch - 1) / kStepBatch;
-  RowFetch* fetch = s.edge_fetch;
+  RowFetch* fetch = plan.edge_fetch;
   const auto add = [&](RowFetch f) {
     if (f.rows_begin < f.rows_end &&
         f.rows_end - f.rows_begin <= (f.end_batch - f.first_batch) * kStepBatch * kMostRowsPerBall)
@@ -288,7 +273,7 @@ void World::add_edge_fetches(StepArrays& s, std::uint32_t begin, std::uint32_t e
     while (lead < last && reach[lead].lowest < begin) ++lead;
     if (lead == last) lead = first;  // every batch reads below: no batch to run meanwhile
     const std::uint32_t lead_end = std::min(last, lead + kBelowWindow);
-    if (lead > first) s.lead_begin = lead * kStepBatch, s.lead_end = std::min(end, lead_end * kStepBatch);
+    if (lead > first) plan.lead_begin = lead * kStepBatch, plan.lead_end = std::min(end, lead_end * kStepBatch);
     add({lowest, begin, lead, lead_end});
   }
   if (end < n_) {
@@ -306,11 +291,8 @@ float World::kick_drift(std::uint32_t i, const Float4& a) {
                               pos_next_[i]);
 }
 
-// The last pass read vel_half = v(t - dt/2) and wrote vel_half_next =
-// v(t) + a dt/2 = v(t + dt/2), so v(t) is their mean. Storing it from the
-// pass cost 16 of the bytes it writes per ball every step (with the read for
-// ownership, 32 of ~180 it moves in a million-ball scene), for observers that
-// look 60 times a second at most.
+// v(t) is the mean of vel_half = v(t - dt/2) and vel_half_next = v(t + dt/2): derived for observers,
+// who look a few dozen times a second, instead of stored by every step.
 void World::derive_velocities() const {
   if (!vel_stale_) return;
   for (std::uint32_t i = 0; i < n_; ++i) {
@@ -327,9 +309,7 @@ const Float4* World::velocities() const {
 }
 
 void World::start_from_current_state() {
-  // The pass needs this step's half-step velocities, which come from a(t):
-  // forces from the current positions with v(t) standing in for v(t - dt/2),
-  // then the first half kick and the drift for every ball.
+  // The half-step velocities come from a(t), with v(t) standing in for v(t - dt/2) in the damping.
   derive_velocities();
   if (needs_rebuild_) rebuild();
   PhaseTimer timer(phase_seconds_.step_pass);
@@ -340,45 +320,37 @@ void World::start_from_current_state() {
   });
   next_max_d2_ = 0.0f;
   for (std::uint32_t i = 0; i < n_; ++i) next_max_d2_ = std::max(next_max_d2_, kick_drift(i, acc_[i]));
-  far_listed_ = false;  // this pass lists no far balls: past skin / 2 the lists are rebuilt
+  strayed_listed_ = false;  // this pass lists no strayed balls: past skin / 2 the lists are rebuilt
   needs_initial_forces_ = false;
 }
 
 bool World::lists_hold() {
-  // Two balls that each moved at most skin / 2 since the build cannot have
-  // closed the skin between them unseen. Past that the lists are kept while
-  // every ball that moved further (a few fast ones, the step pass lists them)
-  // touches only balls in its list, checked one by one while a check is
-  // worth it (NeighbourList::can_check: until the fastest has moved about a
-  // cell's width), and while checking costs less than rebuilding (below).
+  // Two balls that each moved at most skin / 2 cannot have closed the skin unseen. Past that the
+  // lists are kept while every strayed ball touches only listed balls and checking costs less than rebuilding.
   if (next_max_d2_ <= half_skin_d2()) return true;
-  if (!far_listed_ || !std::isfinite(next_max_d2_)) return false;
+  if (!strayed_listed_ || !std::isfinite(next_max_d2_)) return false;
   const float moved = std::sqrt(next_max_d2_);
   if (!list_.can_check(moved)) return false;
-  // Each chunk listed its far balls from its begin: gather them to the front.
-  std::uint32_t far = 0;
+  // Each chunk listed its strayed balls from its begin: gather them to the front.
+  std::uint32_t strayed = 0;
   for (const ChunkMoved& chunk : chunk_moved_) {
-    std::copy_n(far_balls_.begin() + chunk.begin, chunk.moved.far, far_balls_.begin() + far);
-    far += chunk.moved.far;
+    std::copy_n(stray_balls_.begin() + chunk.begin, chunk.moved.strayed, stray_balls_.begin() + strayed);
+    strayed += chunk.moved.strayed;
   }
-  // Far balls grow in number with the time since the build, and so does the
-  // cost of checking them: the lists are kept while this step's checks cost
-  // less than the mean cost per step since the build, the rebuild counted in
-  // (in checks, not seconds, so that the choice is the same for any thread
-  // count), and while the step checks few balls.
-  const double cycle_cost = kRebuildCostInChecksPerBall * n_ + double(far_checked_ - far_checked_at_build_);
+  // Kept while this step's checks cost less than the mean per step since the build, the rebuild
+  // counted in: in checks, not seconds, so that the choice is the same for any thread count.
+  const double cycle_cost = kRebuildCostInChecksPerBall * n_ + double(strayed_checked_ - strayed_checked_at_build_);
   const double steps_since_build = double(steps_ - built_at_step_);
-  if (double(far) * steps_since_build >= cycle_cost || far > n_ / kFarBallsPerCheck + 16) return false;
-  far_checked_ += far;
-  PhaseTimer timer(phase_seconds_.neighbours), check_timer(phase_seconds_.far_checks);
+  if (double(strayed) * steps_since_build >= cycle_cost || strayed > n_ / kStrayedBallsPerCheck + 16) return false;
+  strayed_checked_ += strayed;
+  PhaseTimer timer(phase_seconds_.neighbours), check_timer(phase_seconds_.stray_checks);
   std::fill(chunk_missing_.begin(), chunk_missing_.end(), 0);
-  // A check costs a few dozen balls' steps (0.2-0.5 us): a few are worth a thread.
-  pool_.run_costly(far, kFarChecksPerThread, [&](std::uint32_t begin, std::uint32_t end, int chunk) {
+  pool_.run_costly(strayed, kStrayChecksPerThread, [&](std::uint32_t begin, std::uint32_t end, int chunk) {
     for (std::uint32_t k = begin; k < end && !chunk_missing_[chunk]; ++k)
-      chunk_missing_[chunk] = list_.misses_contact(far_balls_[k], pos_.data(), pos_at_build_.data(), moved);
+      chunk_missing_[chunk] = list_.misses_contact(stray_balls_[k], pos_.data(), pos_at_build_.data(), moved);
   });
   if (std::find(chunk_missing_.begin(), chunk_missing_.end(), 1) != chunk_missing_.end()) return false;
-  ++lists_kept_far_;
+  ++lists_kept_by_checks_;
   return true;
 }
 
@@ -421,16 +393,17 @@ void World::advance() {
   PhaseTimer timer(phase_seconds_.step_pass);
   std::fill(chunk_moved_.begin(), chunk_moved_.end(), ChunkMoved{});
   StepArrays s = arrays();
-  s.far_d2 = half_skin_d2() * kFarMargin;  // every ball lists_hold() will count as far, and a hair more
-  s.far_balls = far_balls_.data();
+  s.stray_d2 = half_skin_d2() * kStrayMargin;  // every ball lists_hold() will count as strayed, and a hair more
+  s.stray_balls = stray_balls_.data();
+  const PrefetchPlan plan = prefetch_plan();
   pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int chunk) {
-    StepArrays part = s;
-    add_edge_fetches(part, begin, end);
-    chunk_moved_[chunk] = {begin, kernels_.step(part, model_, begin, end)};
+    PrefetchPlan chunk_plan = plan;
+    add_edge_fetches(chunk_plan, begin, end);
+    chunk_moved_[chunk] = {begin, kernels_.step(s, chunk_plan, model_, begin, end)};
   });
   next_max_d2_ = 0.0f;
   for (const ChunkMoved& chunk : chunk_moved_) next_max_d2_ = std::max(next_max_d2_, chunk.moved.max_d2);
-  far_listed_ = true;
+  strayed_listed_ = true;
   vel_stale_ = true;
   time_ += model_.dt;
   ++steps_;

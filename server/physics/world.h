@@ -7,20 +7,15 @@
 //   spawn round (every kSpawnInterval steps while balls are queued)
 //   swap           the last pass's pos_next, vel_half_next become pos, vel_half
 //   players move   (serial, few)
-//   rebuild?       if a ball moved > skin/2 and the lists miss one of its
-//                  contacts (or the check cannot reach that far, or many
-//                  balls moved that far): sort by cell, reorder, new lists
+//   rebuild?       if a ball strayed > skin/2 and the lists miss one of its
+//                  contacts (or checking costs more): sort by cell, reorder, new lists
 //   step pass    ║ parallel over balls (kernels.h): a = F/m + g, v = v_half + a dt/2,
 //                  then the next half kick and drift into pos_next, vel_half_next
 //
-// Between steps pos and vel are the state at time(); the next step's
-// positions are already computed, so one pass and one barrier make a step.
-// The pass does not store vel: it is the mean of the half-step velocities on
-// either side, derived when asked for (velocities(), ball(), the energies,
-// the hash), not every step.
-//
-// Ball arrays are reordered by every rebuild; id() gives each ball's
-// permanent number (its order of appearance) for anyone who tracks balls.
+// Between steps pos is the state at time() and the next step's positions are
+// already computed, so one pass and one barrier make a step. vel is derived
+// when asked for: the mean of the half-step velocities either side.
+// Every rebuild reorders the balls; ids() gives their permanent numbers.
 
 #include <chrono>
 #include <cstdint>
@@ -43,11 +38,10 @@ struct PhaseSeconds {
   double spawn = 0.0;
   double neighbours = 0.0;  // sort, reorder and list build, and checks that keep the lists
   double step_pass = 0.0;   // forces and integration
-  // Parts of neighbours: the balls sorted by cell and their arrays reordered,
-  // the lists built, and the far balls checked (World::lists_hold).
+  // Parts of neighbours: sort and reorder, list build, checks of strayed balls (World::lists_hold).
   double sort = 0.0;
   double list_build = 0.0;
-  double far_checks = 0.0;
+  double stray_checks = 0.0;
 };
 
 struct AddResult {
@@ -68,9 +62,8 @@ class World {
 
   // Queues balls to pour in from the top, up to max_balls() including those queued.
   AddResult add_balls(std::int64_t count);
-  // Puts one ball exactly there, without any overlap check (scenes and tests).
-  // Spawned balls touch nothing, so their first acceleration is gravity alone;
-  // placed ones may touch, so the next step starts with a force pass.
+  // Puts one ball exactly there, without any overlap check (scenes and tests); it may touch others,
+  // so the next step starts with a force pass.
   void place_ball(int kind, Vec3 pos, Vec3 vel);
   void set_max_balls(std::uint32_t max_balls) { max_balls_ = max_balls; }
 
@@ -97,11 +90,10 @@ class World {
   double time() const { return time_; }
   std::uint64_t steps() const { return steps_; }
   std::uint64_t rebuilds() const { return rebuilds_; }
-  // Steps whose lists were kept after checking the balls that had moved more
-  // than skin / 2 since the build (lists_hold()).
-  std::uint64_t lists_kept_far() const { return lists_kept_far_; }
+  // Steps whose lists were kept after checking the balls that strayed more than skin / 2 (lists_hold()).
+  std::uint64_t lists_kept_by_checks() const { return lists_kept_by_checks_; }
   // Balls checked in those steps and in the steps whose checks found a contact.
-  std::uint64_t far_balls_checked() const { return far_checked_; }
+  std::uint64_t strayed_balls_checked() const { return strayed_checked_; }
   // The lists of the last build, for tests and tools.
   const NeighbourList& neighbour_list() const { return list_; }
   float dt() const { return model_.dt; }
@@ -111,8 +103,7 @@ class World {
   int threads() const { return pool_.threads(); }
   // Steps use at most this many of the threads (results do not depend on it).
   void set_thread_limit(int limit) { pool_.set_active_limit(limit); }
-  // Lets each step choose between every thread and one by measurement, as the
-  // machine's load changes (ThreadTuner); off by default.
+  // Lets each step choose between every thread and one as the machine's load changes (ThreadTuner).
   void set_thread_tuning(bool on);
   // The threads the steps use: the tuner's choice between its probes.
   int stepping_threads() const;
@@ -158,24 +149,23 @@ class World {
   // Whether the lists still hold every contact of the next step's positions.
   bool lists_hold();
   float half_skin_d2() const { return 0.25f * params_.skin * params_.skin; }  // (skin / 2)^2
-  // Placed balls may start in contact: their first half kick needs the real
-  // force, so the next step's half-step state is computed anew for every ball.
+  // Placed balls may start in contact: the next step's half-step state is computed anew from real forces.
   void start_from_current_state();
-  // Ball i's half kick with acceleration a and drift into the next-step
-  // buffers; returns its squared distance from where the lists were built.
+  // Ball i's half kick and drift into the next-step buffers (fishtank::kick_drift).
   float kick_drift(std::uint32_t i, const Float4& a);
   void move_players();
   void resize(std::uint32_t n);
   void set_ghost();
   StepArrays arrays();
-  // Whether the step pass's arrays (about 140 bytes per ball) outgrow the
-  // second-level caches of this machine's two cores (1 MB each), so that the
-  // step asks for rows ahead (StepArrays::beyond_cache).
+  // Whether the SIMD step asks for rows ahead (PrefetchPlan): from kBeyondCacheBalls balls.
   bool beyond_cache() const { return n_ >= kBeyondCacheBalls; }
+  // Tunable: about where the step's arrays (some 140 bytes a ball) outgrow second-level caches; below
+  // it, asking ahead costs instructions and buys nothing.
   static constexpr std::uint32_t kBeyondCacheBalls = 32768;
   void derive_velocities() const;
   void advance();  // one step, untimed
-  void add_edge_fetches(StepArrays& s, std::uint32_t begin, std::uint32_t end) const;
+  PrefetchPlan prefetch_plan() const;
+  void add_edge_fetches(PrefetchPlan& plan, std::uint32_t begin, std::uint32_t end) const;
 
   PhysicsParams params_;
   ContactModel model_;
@@ -191,8 +181,7 @@ class World {
   // The half-step rows' w is 1 / mass (StepArrays::vel_half), vel_'s the mass.
   AlignedVector<Float4> pos_, vel_half_;
   AlignedVector<Float4> pos_next_, vel_half_next_;  // written by the step pass
-  // The full-step velocity at time(): stale after a pass until derived from
-  // vel_half_ and vel_half_next_ (derive_velocities).
+  // The full-step velocity at time(), stale after a pass until derive_velocities().
   mutable AlignedVector<Float4> vel_;
   mutable bool vel_stale_ = false;
   AlignedVector<Float4> acc_;  // scratch: start_from_current_state(), rebuild()
@@ -210,33 +199,23 @@ class World {
 
   std::uint32_t capacity_;
   std::uint32_t max_balls_;
-  // A far ball's check costs what rebuilding the lists costs per two balls
-  // (on two threads: 0.26 us a check against 132 ns a ball's share of a
-  // rebuild in the settled tank, 0.29 us against 152 ns with 10 000 balls of
-  // the wide scene, 0.56 us against 148 ns with a million; the step benchmarks'
-  // check_us_per_step, far_per_step and rebuild_us, fishtank-bench-variants).
+  // Tunable: a strayed ball's check costs about what a rebuild costs per two balls (measured, report).
   static constexpr double kRebuildCostInChecksPerBall = 0.5;
-  // Past n / kFarBallsPerCheck (+ 16) far balls the lists are rebuilt
-  // whatever the checks cost so far: in the wide scene's million, checks go
-  // on finding nothing well past that count, only to end in a contact the
-  // lists lack a few steps later, with half again the checks per step
-  // (measured in a build without this bound: 669-738 us of checks per step
-  // against 474-505, the same 40 rebuilds per 1000 steps).
-  static constexpr std::uint32_t kFarBallsPerCheck = 256;
-  // Far balls' checks per thread at least: a check costs a few dozen balls'
-  // steps, so from 8 checks two threads share them (measured within
-  // this machine's noise: +1.4, -1.5 and +1.5 % of a settled tank's step).
-  static constexpr std::uint32_t kFarChecksPerThread = 4;
-  static constexpr float kFarMargin = 1.0f - 1e-5f;  // a ball right at skin / 2 counts as far
+  // Past n / kStrayedBallsPerCheck (+ 16) strayed balls the lists are rebuilt: by then checks go on
+  // finding nothing only to end in a missed contact a few steps later.
+  static constexpr std::uint32_t kStrayedBallsPerCheck = 256;
+  // A check costs a few dozen balls' steps: a thread takes at least this many.
+  static constexpr std::uint32_t kStrayChecksPerThread = 4;
+  static constexpr float kStrayMargin = 1.0f - 1e-5f;  // a ball right at skin / 2 counts as strayed
   // What each chunk of the last step pass reported.
   struct ChunkMoved {
     std::uint32_t begin = 0;
     Moved moved;
   };
   std::vector<ChunkMoved> chunk_moved_;
-  std::vector<char> chunk_missing_;           // per chunk: a far ball misses a contact
-  std::vector<std::uint32_t> far_balls_;      // per chunk, from its begin: its far balls
-  bool far_listed_ = false;                   // whether the last pass listed them
+  std::vector<char> chunk_missing_;           // per chunk: a strayed ball misses a contact
+  std::vector<std::uint32_t> stray_balls_;    // per chunk, from its begin: its strayed balls
+  bool strayed_listed_ = false;               // whether the last pass listed them
   std::vector<std::uint32_t> chunk_longest_;  // per chunk: the longest list it built
   std::vector<std::uint32_t> order_;
   std::vector<NewBall> placed_;
@@ -245,9 +224,9 @@ class World {
   std::uint64_t steps_ = 0;
   std::uint64_t one_thread_steps_ = 0;
   std::uint64_t rebuilds_ = 0;
-  std::uint64_t lists_kept_far_ = 0;
-  std::uint64_t far_checked_ = 0;
-  std::uint64_t built_at_step_ = 0, far_checked_at_build_ = 0;  // steps_ and far_checked_ at the last build
+  std::uint64_t lists_kept_by_checks_ = 0;
+  std::uint64_t strayed_checked_ = 0;
+  std::uint64_t built_at_step_ = 0, strayed_checked_at_build_ = 0;  // at the last build
   PhaseSeconds phase_seconds_;
 };
 

@@ -91,10 +91,10 @@ TEST_CASE("the lists hold every touching pair at every step while fast balls fly
   const std::uint32_t player = world.add_player();
   world.set_player_velocity(player, Vec3{1.0f, -0.3f, 0.5f} * params.player_max_speed);
 
-  const std::uint64_t rebuilds_before = world.rebuilds(), kept_before = world.lists_kept_far();
+  const std::uint64_t rebuilds_before = world.rebuilds(), kept_before = world.lists_kept_by_checks();
   const std::size_t contacts_checked = step_checking_lists(world, 1500);
-  const std::uint64_t rebuilds = world.rebuilds() - rebuilds_before, kept = world.lists_kept_far() - kept_before;
-  INFO("rebuilds " << rebuilds << ", lists kept after checking the far balls " << kept);
+  const std::uint64_t rebuilds = world.rebuilds() - rebuilds_before, kept = world.lists_kept_by_checks() - kept_before;
+  INFO("rebuilds " << rebuilds << ", lists kept after checking the strayed balls " << kept);
   CHECK(contacts_checked > 1500 * 250);  // a pile, not a gas
   CHECK(kept > 100);                     // the path under test ran often
   CHECK(rebuilds > 10);
@@ -107,7 +107,7 @@ TEST_CASE("two balls closing head-on from beyond the skin get a rebuild before t
   // more than the half skin after which the lists are only kept if checked
   // (with 20 + 8 the slower ball stays under the half skin: only the faster
   // one is checked).
-  // Only the check of the far balls can see the contact coming; nothing else
+  // Only the check of the strayed balls can see the contact coming; nothing else
   // moves.
   const std::string variant = GENERATE(from_range(variant_names()));
   INFO(variant);
@@ -128,9 +128,9 @@ TEST_CASE("two balls closing head-on from beyond the skin get a rebuild before t
     world.place_ball(0, centre + Vec3{0.5f * gap, 0.0f, 0.0f}, {-slower[pair / 3], 0.0f, 0.0f});
   }
   const std::size_t contacts = step_checking_lists(world, 60);
-  CHECK(contacts > 0);                // they met...
-  CHECK(world.lists_kept_far() > 0);  // ...after steps with far balls and kept lists
-  CHECK(world.rebuilds() >= 2);       // and a rebuild came before each contact
+  CHECK(contacts > 0);                      // they met...
+  CHECK(world.lists_kept_by_checks() > 0);  // ...after steps with strayed balls and kept lists
+  CHECK(world.rebuilds() >= 2);             // and a rebuild came before each contact
 }
 
 TEST_CASE("the check finds a contact between two balls that both moved well past the skin", "[physics][broadphase]") {

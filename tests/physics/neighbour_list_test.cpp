@@ -2,7 +2,7 @@
 // the same order, however many of the neighbouring cells a ball's reach lets
 // it skip, reports lists that do not fit instead of overrunning, says which
 // balls each batch's lists reach, and gives each SIMD group its record and
-// each batch its far rows.
+// each batch its remote rows.
 
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -22,7 +22,7 @@ struct Lists {
   std::vector<std::vector<std::uint32_t>> entries;  // the stored part of each list
   AlignedVector<Float4> pos;                        // the balls in the sorted order entries index
   std::uint32_t longest = 0;
-  std::size_t far_lines_well_away = 0;  // SIMD builds: lines of rows named 32 batches or more from their batch
+  std::size_t remote_lines_well_away = 0;  // SIMD builds: lines of rows named 32 batches or more from their batch
 };
 
 // n random balls of every kind, packed densely enough that many lists are long;
@@ -109,13 +109,13 @@ Lists build(const Kernels& kernels, const TankBounds& tank, const AlignedVector<
       REQUIRE(list.group_blocks()[place / lanes] == longest);
     }
   }
-  // Each batch's far rows (SIMD builds) are distinct lines of rows that its
+  // Each batch's remote rows (SIMD builds) are distinct lines of rows that its
   // lists name, none of its own, and include every line they name 32 batches
   // or more away (the step's window is narrower), while there is room.
-  constexpr std::uint32_t kRowsPerLine = FarRows::kRowsPerLine, kWellAway = 32 * kStepBatch;
+  constexpr std::uint32_t kRowsPerLine = RemoteRows::kRowsPerLine, kWellAway = 32 * kStepBatch;
   for (std::uint32_t batch = 0; lanes > 1 && batch < n; batch += kStepBatch) {
-    const FarRows& far = list.far_rows()[batch / kStepBatch];
-    std::vector<std::uint32_t> named, noted(far.rows, far.rows + far.count), well_away;
+    const RemoteRows& remote = list.remote_rows()[batch / kStepBatch];
+    std::vector<std::uint32_t> named, noted(remote.rows, remote.rows + remote.count), well_away;
     for (std::uint32_t i = batch; i < batch_end(batch, n); ++i)
       for (std::uint32_t j : out.entries[i]) {
         named.push_back(j / kRowsPerLine * kRowsPerLine);
@@ -129,9 +129,9 @@ Lists build(const Kernels& kernels, const TankBounds& tank, const AlignedVector<
     REQUIRE(std::adjacent_find(noted.begin(), noted.end()) == noted.end());
     REQUIRE(std::includes(named.begin(), named.end(), noted.begin(), noted.end()));
     for (std::uint32_t row : noted) REQUIRE((row + kRowsPerLine <= batch || row >= batch + kStepBatch));
-    if (far.count < FarRows::kMost)
+    if (remote.count < RemoteRows::kMost)
       REQUIRE(std::includes(noted.begin(), noted.end(), well_away.begin(), well_away.end()));
-    out.far_lines_well_away += well_away.size();
+    out.remote_lines_well_away += well_away.size();
   }
   return out;
 }
@@ -181,7 +181,7 @@ TEST_CASE("every list build finds the same neighbours as a brute-force search", 
     CHECK(simd.counts == scalar.counts);
     CHECK(simd.entries == scalar.entries);  // same neighbours in the same order
     if (width == 60.0f && kernels_named(name).list_lanes > 1)
-      CHECK(simd.far_lines_well_away > 0);  // rows across the block edge are far
+      CHECK(simd.remote_lines_well_away > 0);  // rows across the block edge are remote
   }
 }
 
