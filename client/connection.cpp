@@ -155,7 +155,10 @@ void Connection::handle(const wire::Message& message) {
     }
     case wire::Payload::Error: {
       const wire::Error& e = *message.payload_as_Error();
-      stats_.errors.push_back(std::string(wire::EnumNameErrorCode(e.code())) + ": " + e.message()->str());
+      // A code newer than this client has no name here: its number instead.
+      const char* name = wire::EnumNameErrorCode(e.code());
+      stats_.error_codes.push_back(*name ? name : std::to_string(static_cast<int>(e.code())));
+      stats_.errors.push_back(stats_.error_codes.back() + ": " + e.message()->str());
       break;
     }
     case wire::Payload::Pong: {

@@ -20,9 +20,10 @@ namespace fishtank::client {
 struct ConnectionStats {
   std::uint64_t snapshots = 0;
   std::uint64_t bytes_received = 0;
-  std::uint64_t skipped_snapshots = 0;  // gaps in Snapshot.tick
-  std::vector<double> rtt_ms;           // one per Pong
-  std::vector<std::string> errors;      // Error messages, "code: message"
+  std::uint64_t skipped_snapshots = 0;   // gaps in Snapshot.tick
+  std::vector<double> rtt_ms;            // one per Pong
+  std::vector<std::string> errors;       // Error messages, "code: message"
+  std::vector<std::string> error_codes;  // the code of each Error, e.g. "too_slow"
   // Of the balls in both of the last two snapshots, the fraction whose quantised
   // position did not change: what an at-rest (delta) encoding could leave out.
   double at_rest_fraction = 0.0;

@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
                         {"int8_delta_fraction", s.int8_delta_fraction},
                         {"dropped", s.dropped},
                         {"errors", s.error_messages.size()},
+                        {"error_codes", s.error_codes},
                         {"error_messages", s.error_messages}};
     std::cout << j.dump() << std::endl;
   } else {

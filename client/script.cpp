@@ -36,6 +36,9 @@ Summary summarise(const std::vector<std::shared_ptr<Connection>>& connections, d
           (st.snapshots - 1) / std::chrono::duration<double>(*st.last_snapshot - *st.first_snapshot).count();
     rtts.insert(rtts.end(), st.rtt_ms.begin(), st.rtt_ms.end());
     s.error_messages.insert(s.error_messages.end(), st.errors.begin(), st.errors.end());
+    for (const std::string& code : st.error_codes)
+      if (std::find(s.error_codes.begin(), s.error_codes.end(), code) == s.error_codes.end())
+        s.error_codes.push_back(code);
     if (st.snapshots > 0 && c->view().tick >= newest_tick) {
       newest_tick = c->view().tick;
       s.balls = c->view().ball_count;

@@ -54,7 +54,8 @@ struct Summary {
   double at_rest_fraction = 0.0;     // in that newest snapshot (ConnectionStats::at_rest_fraction)
   double int8_delta_fraction = 0.0;  // likewise (ConnectionStats::int8_delta_fraction)
   std::vector<std::string> error_messages;
-  std::string connect_error;  // non-empty when no connection could be made
+  std::vector<std::string> error_codes;  // the server's Error codes, each once, in the order first seen
+  std::string connect_error;             // non-empty when no connection could be made
   // Connections the server closed before --duration was up (each also has an
   // error message saying why); the script ends early once all are closed.
   int dropped = 0;

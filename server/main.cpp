@@ -110,6 +110,7 @@ fishtank::net::ServerInfo server_info(const fishtank::World& world, const fishta
   info.dt = world.dt();
   info.snapshot_rate_hz = static_cast<float>(o.snapshot_rate);
   info.control = o.control;
+  info.limits = o.limits;
   return info;
 }
 

@@ -64,6 +64,28 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "who may pause, step, reset, switch scene and set the time scale: players (clients with a player sphere), "
       "everyone or nobody");
 
+  net::ClientLimits& limits = o.limits;
+  std::int64_t max_connections = limits.max_connections;
+  std::string add_rights = "players";
+  po::options_description guard(
+      "Limits per client (a peer past one gets an Error saying which; a connection costs the server at most "
+      "about 1.1 MiB of memory, so 64 about 72 MiB)");
+  guard.add_options()("max-connections", po::value(&max_connections)->default_value(max_connections),
+                      "clients at most; later ones get server_full and are closed")(
+      "hello-timeout", po::value(&limits.hello_timeout_s)->default_value(limits.hello_timeout_s),
+      "seconds a new connection has to send its Hello (hello_timeout)")(
+      "idle-timeout", po::value(&limits.idle_timeout_s)->default_value(limits.idle_timeout_s),
+      "seconds a client may go without reading what it is sent: idle_timeout if it sent nothing either, "
+      "too_slow if it did")("player-idle", po::value(&limits.player_idle_s)->default_value(limits.player_idle_s),
+                            "seconds a player sphere may stand unmoved before it is freed and its client "
+                            "observes (player_idle); 0: never")(
+      "max-commands", po::value(&limits.max_commands_per_s)->default_value(limits.max_commands_per_s),
+      "messages a second per client, as many in a burst; more: command_flood and a disconnect")(
+      "add-rights", po::value(&add_rights)->default_value(add_rights),
+      "who may add balls: players (clients with a sphere), everyone or nobody; others get not_permitted")(
+      "add-rate", po::value(&limits.add_balls_per_minute)->default_value(limits.add_balls_per_minute),
+      "balls a minute each client may add, as many at once; beyond it rate_limited");
+
   po::options_description physics("Physics");
   physics.add_options()("stiffness", po::value(&o.physics.stiffness)->default_value(defaults.stiffness, "25000"),
                         "contact spring constant k, N/m")(
@@ -83,7 +105,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "most simulated seconds to wait for rest (0: 90 for tank, 4 for wide)");
 
   po::options_description all;
-  all.add(general).add(network).add(physics).add(bench).add(output);
+  all.add(general).add(network).add(guard).add(physics).add(bench).add(output);
 
   ParseResult result;
   std::ostringstream help;
@@ -150,6 +172,19 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   const std::optional<ControlPolicy> policy = parse_control_policy(control);
   if (!policy) return fail("--control must be players, everyone or nobody, got '" + control + "'");
   o.control = *policy;
+  if (max_connections < 1 || max_connections > 100000)
+    return fail("--max-connections must be between 1 and 100000, got " + std::to_string(max_connections));
+  const auto within = [](double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; };
+  if (!within(limits.hello_timeout_s, 0.1, 3600.0)) return fail("--hello-timeout must be between 0.1 and 3600 seconds");
+  if (!within(limits.idle_timeout_s, 0.1, 86400.0)) return fail("--idle-timeout must be between 0.1 and 86400 seconds");
+  if (!within(limits.player_idle_s, 0.0, 86400.0)) return fail("--player-idle must be between 0 and 86400 seconds");
+  if (!within(limits.max_commands_per_s, 1.0, 1e6)) return fail("--max-commands must be between 1 and 1000000");
+  if (!within(limits.add_balls_per_minute, 0.0, 1e7)) return fail("--add-rate must be between 0 and 10000000");
+  const std::optional<ControlPolicy> rights = parse_control_policy(add_rights);
+  if (!rights) return fail("--add-rights must be players, everyone or nobody, got '" + add_rights + "'");
+  limits.add_rights = *rights;
+  limits.max_connections = static_cast<std::uint32_t>(max_connections);
+
   o.port = static_cast<std::uint16_t>(port);
   o.max_players = static_cast<std::uint32_t>(max_players);
   o.physics.steps_per_contact = static_cast<int>(steps_per_contact);

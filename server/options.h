@@ -7,6 +7,7 @@
 
 #include "server/bench/benchmark.h"
 #include "server/control_policy.h"
+#include "server/net/client_limits.h"
 #include "server/physics/params.h"
 
 namespace fishtank {
@@ -34,6 +35,7 @@ struct ServerOptions {
   double snapshot_rate = 60.0;
   std::uint32_t max_players = 8;
   ControlPolicy control = ControlPolicy::players;  // who may pause, step, reset, switch scene, set the time scale
+  net::ClientLimits limits;
 };
 
 struct ParseResult {

@@ -1,10 +1,27 @@
 #include "server/net/client_protocol.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "common/scene_names.h"
 
 namespace fishtank::net {
+
+namespace {
+// "5 s", "0.5 s": a limit as the flag gave it.
+std::string seconds_text(double s) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g s", s);
+  return text;
+}
+}  // namespace
+
+ClientProtocol::ClientProtocol(std::uint32_t client_id, const ServerInfo& info)
+    : client_id_(client_id),
+      info_(info),
+      commands_(info.limits.max_commands_per_s, info.limits.max_commands_per_s),
+      balls_(info.limits.add_balls_per_minute / 60.0, info.limits.add_balls_per_minute) {}
 
 Outcome ClientProtocol::refuse(wire::ErrorCode code, const std::string& why, bool disconnect) {
   Outcome out;
@@ -18,9 +35,24 @@ Outcome ClientProtocol::on_broken_stream(const protocol::DecodeResult& refused) 
   return refuse(wire::ErrorCode::malformed_frame, refused.why, /*disconnect=*/true);
 }
 
-Outcome ClientProtocol::on_frame(const std::uint8_t* frame, std::size_t size) {
+protocol::DecodeResult ClientProtocol::check_length_prefix(const std::uint8_t* prefix,
+                                                           std::uint32_t* body_bytes) const {
+  protocol::DecodeResult r = protocol::check_length_prefix(prefix, protocol::Direction::to_server, body_bytes);
+  if (r.ok() && !hello_received() && *body_bytes > kMaxFirstFrameBytes)
+    return {protocol::DecodeStatus::bad_length, nullptr,
+            "the first frame announces " + std::to_string(*body_bytes) + " bytes; a Hello is at most " +
+                std::to_string(kMaxFirstFrameBytes)};
+  return r;
+}
+
+Outcome ClientProtocol::on_frame(const std::uint8_t* frame, std::size_t size, Clock::time_point now) {
   const protocol::DecodeResult decoded = protocol::decode_frame(frame, size, protocol::Direction::to_server);
   if (decoded.stream_broken()) return on_broken_stream(decoded);
+  if (hello_received() && !commands_.take(1.0, now))
+    return refuse(wire::ErrorCode::command_flood,
+                  "more than " + std::to_string(std::lround(info_.limits.max_commands_per_s)) +
+                      " messages a second (--max-commands)",
+                  /*disconnect=*/true);
   if (state_ == State::awaiting_hello) {
     if (!decoded.ok() || decoded.message->payload_type() != wire::Payload::Hello)
       return refuse(
@@ -33,7 +65,7 @@ Outcome ClientProtocol::on_frame(const std::uint8_t* frame, std::size_t size) {
     return refuse(wire::ErrorCode::invalid_value, decoded.why + "; message ignored", /*disconnect=*/false);
   if (decoded.status == protocol::DecodeStatus::wrong_direction)
     return refuse(wire::ErrorCode::unexpected_message, decoded.why, /*disconnect=*/false);
-  return on_message(*decoded.message);
+  return on_message(*decoded.message, now);
 }
 
 std::string printable_name(const std::string& raw) {
@@ -67,19 +99,19 @@ Outcome ClientProtocol::on_hello(const wire::Hello& hello) {
   return out;
 }
 
-Outcome ClientProtocol::on_message(const wire::Message& message) {
+Outcome ClientProtocol::on_message(const wire::Message& message, Clock::time_point now) {
   Outcome out;
   switch (message.payload_type()) {
     case wire::Payload::Hello:
       return refuse(wire::ErrorCode::unexpected_message, "Hello was already received; message ignored", false);
     case wire::Payload::PlayerInput: {
       const wire::Vec3f& v = *message.payload_as_PlayerInput()->velocity();
+      if (v.x() != 0.0f || v.y() != 0.0f || v.z() != 0.0f) last_move_ = now;
       out.command = Command{client_id_, SetVelocityCommand{{v.x(), v.y(), v.z()}}};
       return out;
     }
     case wire::Payload::AddBalls:
-      out.command = Command{client_id_, AddBallsCommand{message.payload_as_AddBalls()->count()}};
-      return out;
+      return on_add_balls(message.payload_as_AddBalls()->count(), now);
     case wire::Payload::Ping:
       out.replies.push_back(protocol::encode_pong(message.payload_as_Ping()->client_time_us()));
       return out;
@@ -127,6 +159,63 @@ Outcome ClientProtocol::on_control(const wire::Message& message) {
   return out;
 }
 
+Outcome ClientProtocol::on_add_balls(std::uint32_t count, Clock::time_point now) {
+  const ClientLimits& limits = info_.limits;
+  if (limits.add_rights == AddRights::nobody)
+    return refuse(wire::ErrorCode::not_permitted, "nobody may add balls on this server (--add-rights nobody); ignored",
+                  /*disconnect=*/false);
+  if (limits.add_rights == AddRights::players && !has_player_)
+    return refuse(wire::ErrorCode::not_permitted,
+                  "only clients with a player sphere may add balls on this server (--add-rights players); ignored",
+                  /*disconnect=*/false);
+  const auto allowed = static_cast<std::uint32_t>(std::min<double>(count, balls_.available(now)));
+  Outcome out;
+  if (allowed < count)
+    out = refuse(wire::ErrorCode::rate_limited,
+                 "added " + std::to_string(allowed) + " of " + std::to_string(count) + " balls: each client may add " +
+                     std::to_string(std::lround(limits.add_balls_per_minute)) + " a minute (--add-rate)",
+                 /*disconnect=*/false);
+  if (allowed > 0 && balls_.take(allowed, now)) out.command = Command{client_id_, AddBallsCommand{allowed}};
+  return out;
+}
+
+std::optional<ClientProtocol::Clock::time_point> ClientProtocol::player_idle_deadline() const {
+  if (!has_player_ || info_.limits.player_idle_s <= 0.0) return std::nullopt;
+  return last_move_ + limit_duration(info_.limits.player_idle_s);
+}
+
+Outcome ClientProtocol::on_player_idle() {
+  has_player_ = false;
+  Outcome out = refuse(wire::ErrorCode::player_idle,
+                       "your player sphere did not move for " + seconds_text(info_.limits.player_idle_s) +
+                           " (--player-idle) and was freed for others; you are observing now",
+                       /*disconnect=*/false);
+  // Leave removes only the sphere; the connection stays.
+  out.command = Command{client_id_, LeaveCommand{}};
+  return out;
+}
+
+Outcome ClientProtocol::on_hello_timeout() {
+  return refuse(wire::ErrorCode::hello_timeout,
+                "no complete Hello within " + seconds_text(info_.limits.hello_timeout_s) + " (--hello-timeout)",
+                /*disconnect=*/true);
+}
+
+Outcome ClientProtocol::on_write_stalled(bool sent_meanwhile) {
+  const std::string idle = seconds_text(info_.limits.idle_timeout_s);
+  if (sent_meanwhile)
+    return refuse(wire::ErrorCode::too_slow, "the client read nothing for " + idle + " (--idle-timeout)",
+                  /*disconnect=*/true);
+  return refuse(wire::ErrorCode::idle_timeout,
+                "the client neither sent nor read anything for " + idle + " (--idle-timeout)",
+                /*disconnect=*/true);
+}
+
+Outcome ClientProtocol::on_replies_piling_up(std::size_t unsent) {
+  return refuse(wire::ErrorCode::too_slow,
+                "the client does not read its replies (" + std::to_string(unsent) + " unsent)", /*disconnect=*/true);
+}
+
 Outcome ClientProtocol::on_reply(const Reply& reply) {
   Outcome out;
   if (const auto* joined = std::get_if<JoinedReply>(&reply.result)) {
@@ -143,6 +232,7 @@ Outcome ClientProtocol::on_reply(const Reply& reply) {
     w.control_policy = describe(info_.control);
     w.may_control = may_control(info_.control, has_player_);
     out.replies.push_back(protocol::encode_welcome(w));
+    last_move_ = Clock::now();
     if (!joined->refusal.empty())
       out.replies.push_back(protocol::encode_error(wire::ErrorCode::player_limit, joined->refusal));
     out.log = joined->player_id

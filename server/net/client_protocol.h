@@ -5,7 +5,12 @@
 //
 //   awaiting_hello ──Hello(version ok)──► joining ──JoinedReply──► active
 //        │  anything else, bad version, broken stream: Error, then disconnect
+//
+// It also enforces the per-client limits that need no clock of its own
+// (client_limits.h): the first frame's size, the command rate, who may add
+// balls and how many, and when an unmoved player sphere is freed.
 
+#include <chrono>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -13,11 +18,13 @@
 
 #include "protocol/frame_codec.h"
 #include "server/control_policy.h"
+#include "server/net/client_limits.h"
 #include "server/net/commands.h"
+#include "server/net/rate_budget.h"
 
 namespace fishtank::net {
 
-// What every Welcome says about this server.
+// What every Welcome says about this server, and the limits every client is held to.
 struct ServerInfo {
   std::string variant;  // the kernel set: "scalar", "sse" or "avx2"
   std::string simd;
@@ -26,6 +33,7 @@ struct ServerInfo {
   float dt = 0.0f;
   float snapshot_rate_hz = 60.0f;
   ControlPolicy control = ControlPolicy::players;
+  ClientLimits limits;
 };
 
 struct Outcome {
@@ -40,27 +48,49 @@ struct Outcome {
 std::string printable_name(const std::string& raw);
 inline constexpr std::size_t kMaxNameBytes = 64;
 
+// A Hello is a few dozen bytes: before it, a peer may announce no more than
+// this, so a stranger's first length prefix cannot make the server allocate much.
+inline constexpr std::uint32_t kMaxFirstFrameBytes = 1024;
+
 class ClientProtocol {
  public:
-  ClientProtocol(std::uint32_t client_id, const ServerInfo& info) : client_id_(client_id), info_(info) {}
+  using Clock = std::chrono::steady_clock;
 
+  ClientProtocol(std::uint32_t client_id, const ServerInfo& info);
+
+  // The 4-byte length prefix of the next frame: within the direction's cap, and
+  // before Hello within kMaxFirstFrameBytes. On success *body_bytes is the length.
+  protocol::DecodeResult check_length_prefix(const std::uint8_t* prefix, std::uint32_t* body_bytes) const;
   // A complete frame, length prefix included (decoded and checked here).
-  Outcome on_frame(const std::uint8_t* frame, std::size_t size);
+  Outcome on_frame(const std::uint8_t* frame, std::size_t size, Clock::time_point now = Clock::now());
   // A length prefix that check_length_prefix() refused.
   Outcome on_broken_stream(const protocol::DecodeResult& refused);
   Outcome on_reply(const Reply& reply);
   // The command of an Outcome could not be queued (the physics is behind).
   Outcome on_queue_full();
+  // The player sphere has not moved since player_idle_deadline(): it is freed
+  // (Leave) and the client observes from now on.
+  Outcome on_player_idle();
+  // The session's clock-driven limits, each an Error and a disconnect:
+  // no complete Hello in time; a write that could not finish for --idle-timeout
+  // (sent_meanwhile: the peer sent bytes all the same); replies piling up unsent.
+  Outcome on_hello_timeout();
+  Outcome on_write_stalled(bool sent_meanwhile);
+  Outcome on_replies_piling_up(std::size_t unsent);
 
   // True from the Welcome on: the client gets snapshots.
   bool welcomed() const { return state_ == State::active; }
+  bool hello_received() const { return state_ != State::awaiting_hello; }
   const std::string& client_name() const { return name_; }
+  // When the sphere will be freed unless it moves; empty without a sphere or with --player-idle 0.
+  std::optional<Clock::time_point> player_idle_deadline() const;
 
  private:
   enum class State { awaiting_hello, joining, active };
 
   Outcome on_hello(const wire::Hello& hello);
-  Outcome on_message(const wire::Message& message);
+  Outcome on_message(const wire::Message& message, Clock::time_point now);
+  Outcome on_add_balls(std::uint32_t count, Clock::time_point now);
   Outcome refuse(wire::ErrorCode code, const std::string& why, bool disconnect);
   // Pause, Step, Reset, SetTimeScale: allowed by the policy, values the server knows.
   Outcome on_control(const wire::Message& message);
@@ -70,6 +100,9 @@ class ClientProtocol {
   State state_ = State::awaiting_hello;
   std::string name_;
   bool has_player_ = false;
+  Clock::time_point last_move_;  // the last PlayerInput with a non-zero velocity, or the Welcome
+  RateBudget commands_;
+  RateBudget balls_;
 };
 
 }  // namespace fishtank::net

@@ -6,9 +6,15 @@
 //
 // post_* are the only members called from another thread: they hand their
 // argument to the io thread with asio::post and return at once.
+//
+// Beyond --max-connections a newcomer gets Error(server_full) and is closed.
+// When accept fails (out of file descriptors), the acceptor waits 100 ms,
+// doubling up to 1.6 s, before it tries again; each such episode is logged
+// once when it starts and once when accepting works again, with its count.
 
 #include <atomic>
 #include <boost/asio.hpp>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -44,14 +50,23 @@ class NetServer final : public SessionOwner {
 
  private:
   void do_accept();
+  void admit(boost::asio::ip::tcp::socket socket);
+  void refuse_full(boost::asio::ip::tcp::socket socket);
+  void back_off(const boost::system::error_code& ec);
 
   boost::asio::io_context& io_;
   boost::asio::ip::tcp::acceptor acceptor_;
+  boost::asio::steady_timer accept_retry_;
   ServerInfo info_;
   CommandQueue& commands_;
   std::unordered_map<std::uint32_t, std::shared_ptr<Session>> sessions_;
   std::uint32_t next_client_id_ = 1;
   bool stopped_ = false;
+  // The current episode of failed accepts, and of newcomers refused while full.
+  std::uint64_t failed_accepts_ = 0;
+  std::chrono::steady_clock::duration accept_backoff_{};
+  std::chrono::steady_clock::time_point failing_since_;
+  std::uint64_t refused_while_full_ = 0;
   std::atomic<int> viewers_{0};
   std::atomic<int> clients_{0};
   std::atomic<std::uint64_t> bytes_sent_{0};

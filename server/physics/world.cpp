@@ -115,7 +115,7 @@ void World::restart(const TankBounds& tank, std::uint64_t seed) {
   next_id_ = 0;
   energy_added_ = 0.0;
   vel_stale_ = false;
-  far_listed_ = false;
+  strayed_listed_ = false;
   needs_initial_forces_ = false;
   needs_rebuild_ = true;
 }

@@ -20,7 +20,7 @@ using namespace fishtank;
 
 namespace {
 
-const net::ServerInfo kInfo{"sse", "sse4.1", 2, TankBounds{}, 0.001f, 60.0f};
+const net::ServerInfo kInfo{"sse", "sse4.1", 2, TankBounds{}, 0.001f, 60.0f, net::ClientLimits{}};
 
 void check(bool ok) {
   if (!ok) std::abort();

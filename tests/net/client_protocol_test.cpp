@@ -23,3 +23,46 @@ TEST_CASE("a client name with a newline or an escape code is logged escaped and 
   CHECK(net::printable_name("back\\slash") == "back\\x5cslash");  // an escape cannot be faked either
   CHECK(net::printable_name("caf\xc3\xa9") == "caf\\xc3\\xa9");
 }
+
+TEST_CASE("before Hello a peer may announce 1 KiB at most, after it the general cap holds", "[net]") {
+  const net::ServerInfo info;
+  net::ClientProtocol client(1, info);
+  const auto announce = [&](std::uint32_t length) {
+    const std::uint8_t prefix[4] = {static_cast<std::uint8_t>(length), static_cast<std::uint8_t>(length >> 8),
+                                    static_cast<std::uint8_t>(length >> 16), static_cast<std::uint8_t>(length >> 24)};
+    std::uint32_t body = 0;
+    return client.check_length_prefix(prefix, &body).ok();
+  };
+  CHECK(announce(net::kMaxFirstFrameBytes));
+  CHECK_FALSE(announce(net::kMaxFirstFrameBytes + 1));
+  const protocol::Frame hello = protocol::encode_hello("viewer", false);
+  client.on_frame(hello.data(), hello.size());
+  CHECK(announce(protocol::kMaxClientFrameBytes));
+  CHECK_FALSE(announce(protocol::kMaxClientFrameBytes + 1));
+}
+
+TEST_CASE("a burst beyond --max-commands is a command flood, the same rate spread over time is not", "[net]") {
+  net::ServerInfo info;
+  info.limits.max_commands_per_s = 10.0;
+  const auto t0 = net::ClientProtocol::Clock::now();
+  const protocol::Frame hello = protocol::encode_hello("viewer", false);
+  const protocol::Frame ping = protocol::encode_ping(1);
+
+  net::ClientProtocol steady(1, info);
+  steady.on_frame(hello.data(), hello.size(), t0);
+  bool flooded = false;
+  for (int i = 1; i <= 50; ++i)  // 50 Pings over 5 s: 10 a second
+    flooded |= steady.on_frame(ping.data(), ping.size(), t0 + std::chrono::milliseconds(100 * i)).disconnect;
+  CHECK_FALSE(flooded);
+
+  net::ClientProtocol burst(2, info);
+  burst.on_frame(hello.data(), hello.size(), t0);
+  int answered = 0;
+  net::Outcome last;
+  while (!last.disconnect && answered < 50) {
+    last = burst.on_frame(ping.data(), ping.size(), t0);
+    answered += !last.disconnect;
+  }
+  CHECK(answered == 10);  // the burst allowance, then the flood
+  CHECK_THAT(last.log, Catch::StartsWith("command_flood"));
+}

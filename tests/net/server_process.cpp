@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -33,7 +34,7 @@ std::string read_file(const std::string& path) {
 }
 }  // namespace
 
-ServerProcess::ServerProcess(const std::vector<std::string>& args) {
+ServerProcess::ServerProcess(const std::vector<std::string>& args, const std::vector<std::string>& launcher) {
   static int counter = 0;
   log_path_ = (std::filesystem::temp_directory_path() /
                ("fishtank-net-test-" + std::to_string(getpid()) + "-" + std::to_string(counter++) + ".log"))
@@ -45,6 +46,7 @@ ServerProcess::ServerProcess(const std::vector<std::string>& args) {
   if (std::find(args.begin(), args.end(), "--threads") == args.end())
     argv_text.insert(argv_text.end(), {"--threads", "1"});
   argv_text.insert(argv_text.end(), args.begin(), args.end());
+  argv_text.insert(argv_text.begin(), launcher.begin(), launcher.end());
   std::vector<char*> argv;
   for (std::string& a : argv_text) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -77,6 +79,15 @@ ServerProcess::~ServerProcess() {
     waitpid(pid_, nullptr, 0);
   }
   std::error_code ignored;
+  // scripts/test-asan: a server's sanitizer report fails the run even when the
+  // test that started the server passed, so its log is kept for the script.
+  if (const char* reports = std::getenv("FISHTANK_SANITIZER_REPORTS")) {
+    const std::string text = log();
+    if (text.find("runtime error:") != std::string::npos || text.find("Sanitizer") != std::string::npos)
+      std::filesystem::copy_file(log_path_,
+                                 std::filesystem::path(reports) / std::filesystem::path(log_path_).filename(),
+                                 std::filesystem::copy_options::overwrite_existing, ignored);
+  }
   std::filesystem::remove(log_path_, ignored);
 }
 

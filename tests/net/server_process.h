@@ -16,7 +16,8 @@ class ServerProcess {
  public:
   // Starts fishtank-server --bind 127.0.0.1 --port 0 plus `args` (and --threads 1
   // unless they give --threads), and waits (at most 15 s) until it listens. Throws when it does not.
-  explicit ServerProcess(const std::vector<std::string>& args);
+  // `launcher` goes before the server's path, e.g. {"/usr/bin/prlimit", "--nofile=40", "--"}.
+  explicit ServerProcess(const std::vector<std::string>& args, const std::vector<std::string>& launcher = {});
   // SIGKILL if still running.
   ~ServerProcess();
   ServerProcess(const ServerProcess&) = delete;

@@ -16,9 +16,12 @@
 #include "client/script.h"
 #include "protocol/frame_codec.h"
 #include "server_process.h"
+#include "wire_bytes.h"
 
 using namespace fishtank;
 using client::Connection;
+using test::first_error_code;
+using test::frame_with_length;
 using test::RawSocket;
 using test::ServerProcess;
 using Clock = std::chrono::steady_clock;
@@ -75,24 +78,6 @@ std::vector<double> measure_rates(Clients& clients, const std::vector<std::share
   std::vector<double> rates;
   for (std::size_t i = 0; i < of.size(); ++i) rates.push_back((of[i]->stats().snapshots - before[i]) / seconds);
   return rates;
-}
-
-protocol::Frame frame_with_length(std::uint32_t length, std::size_t body_bytes) {
-  protocol::Frame f(4 + body_bytes, 0xAB);
-  for (int i = 0; i < 4; ++i) f[i] = static_cast<std::uint8_t>(length >> (8 * i));
-  return f;
-}
-
-// The first Error code in what a raw socket received (empty if none).
-std::string first_error_code(const std::vector<std::uint8_t>& bytes) {
-  protocol::FrameReader reader(protocol::Direction::to_client);
-  reader.append(bytes.data(), bytes.size());
-  while (auto r = reader.next()) {
-    if (!r->ok()) return {};
-    if (r->message->payload_type() == wire::Payload::Error)
-      return wire::EnumNameErrorCode(r->message->payload_as_Error()->code());
-  }
-  return {};
 }
 
 }  // namespace
@@ -169,7 +154,7 @@ TEST_CASE("more threads than cores are allowed, and the server says they are ove
 TEST_CASE("AddBalls raises the ball count that every client sees - beyond room it gets an Error saying why", "[net]") {
   ServerProcess server({"--balls", "0", "--max-balls", "300"});
   Clients clients(server.port());
-  auto adder = clients.add(false);
+  auto adder = clients.add(true);  // players may add balls (--add-rights players)
   auto watcher1 = clients.add(false);
   auto watcher2 = clients.add(true);
   REQUIRE(clients.wait_until([&] { return clients.all_welcomed(); }, std::chrono::seconds(5)));
@@ -360,10 +345,12 @@ TEST_CASE("clients that never read: the server's memory stays bounded and others
   // AddressSanitizer keeps freed blocks in quarantine (256 MB by default), so
   // the server's RSS grows with every freed snapshot; the Release run checks it.
   WARN("AddressSanitizer build: RSS not meaningful (" << rss_end - rss_start << " kB growth)");
+  // The instrumented server encodes and sends a few times slower; the watcher must still be served.
+  CHECK(rate > 100.0);
 #else
   CHECK(rss_end - rss_start < 8 * 1024);  // unbounded queues would add ~50 MB here
+  CHECK(rate > 300.0);                    // 400 Hz asked
 #endif
-  CHECK(rate > 300.0);  // 400 Hz asked
   CHECK(server.running());
   CHECK(watcher->stats().errors.empty());
 }

@@ -52,6 +52,13 @@ TEST_CASE("the help text (--help) lists every flag and exits 0 without starting 
                            "--snapshot-rate",
                            "--max-players",
                            "--control",
+                           "--max-connections",
+                           "--hello-timeout",
+                           "--idle-timeout",
+                           "--player-idle",
+                           "--max-commands",
+                           "--add-rights",
+                           "--add-rate",
                            "--stiffness",
                            "--restitution",
                            "--steps-per-contact",
@@ -141,6 +148,13 @@ TEST_CASE("every bad value is refused with a message naming it and exit code 2",
       {{"--steps-per-contact", "5"}, "--steps-per-contact must be between 10 and 100000, got 5"},
       {{"--dt", "0.01"}, "unstable for k"},
       {{"--skin", "-0.1"}, "skin"},
+      {{"--max-connections", "0"}, "--max-connections must be between"},
+      {{"--hello-timeout", "0"}, "--hello-timeout"},
+      {{"--idle-timeout", "nan"}, "--idle-timeout"},
+      {{"--player-idle", "-1"}, "--player-idle"},
+      {{"--max-commands", "0"}, "--max-commands"},
+      {{"--add-rights", "observers"}, "--add-rights must be players, everyone or nobody"},
+      {{"--add-rate", "-5"}, "--add-rate"},
       {{"--no-such-flag"}, "no-such-flag"},
   };
   for (const Bad& b : bad) {
@@ -161,4 +175,20 @@ TEST_CASE("the scalar build refuses more than one thread and says which build to
   CHECK_FALSE(r.options);
   CHECK(r.exit_code == 2);
   CHECK(r.message.find("fishtank-server") != std::string::npos);
+}
+
+TEST_CASE("the limits on clients land where the network reads them", "[options]") {
+  const ParseResult r =
+      parse({"--max-connections", "5", "--hello-timeout", "0.5", "--idle-timeout", "2", "--player-idle", "0",
+             "--max-commands", "50", "--add-rights", "everyone", "--add-rate", "100"});
+  REQUIRE(r.options);
+  const net::ClientLimits& l = r.options->limits;
+  CHECK(l.max_connections == 5);
+  CHECK(l.hello_timeout_s == 0.5);
+  CHECK(l.idle_timeout_s == 2.0);
+  CHECK(l.player_idle_s == 0.0);
+  CHECK(l.max_commands_per_s == 50.0);
+  CHECK(l.add_rights == net::AddRights::everyone);
+  CHECK(l.add_balls_per_minute == 100.0);
+  CHECK(parse({}).options->limits.add_rights == net::AddRights::players);
 }
