@@ -19,12 +19,17 @@ int main(int argc, char** argv) {
               << s.connect_error << "\n";
     return 1;
   }
+  // Per ball per snapshot: what a snapshot costs, whatever the rate and the tank.
+  const double bytes_per_ball =
+      s.snapshot_rate_hz > 0.0 && s.balls > 0 ? s.bytes_per_s / (s.snapshot_rate_hz * s.balls) : 0.0;
   if (o.json) {
     nlohmann::json j = {{"clients", s.clients},
                         {"welcomed", s.welcomed},
                         {"snapshots", s.snapshots},
+                        {"keyframes", s.keyframes},
                         {"snapshot_rate_hz", s.snapshot_rate_hz},
                         {"bytes_per_s", s.bytes_per_s},
+                        {"bytes_per_ball", bytes_per_ball},
                         {"rtt_ms", s.rtt_ms},
                         {"balls", s.balls},
                         {"steps_per_s", s.steps_per_s},

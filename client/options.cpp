@@ -42,12 +42,15 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   ClientOptions o;
   std::string connect = "127.0.0.1:7878", move;
   std::int64_t clients = 1, add = 0;
+  bool no_ack = false;
 
   po::options_description flags("Options");
   flags.add_options()("help,h", "print this help and exit")("connect", po::value(&connect)->default_value(connect),
                                                             "server address, host:port")(
       "clients", po::value(&clients)->default_value(clients), "concurrent connections, 1 .. 1000")(
       "observer", po::bool_switch(&o.script.observer), "ask for no player sphere")(
+      "no-ack", po::bool_switch(&no_ack),
+      "never acknowledge snapshots, so that the server sends each in full instead of a delta")(
       "add", po::value(&add)->default_value(0), "balls the first client asks the server to pour in")(
       "move", po::value(&move), "player sphere velocity x,y,z in m/s (every client with a sphere)")(
       "for", po::value(&o.script.move_for)->default_value(o.script.move_for), "seconds to move before stopping")(
@@ -70,7 +73,7 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   if (vm.count("help")) {
     std::ostringstream help;
     help << "fishtank-client: connects to a fishtank-server, runs a short script and reports what it received.\n\n"
-         << "Usage: fishtank-client [--connect host:port] [--clients K] [--observer] [--add N]\n"
+         << "Usage: fishtank-client [--connect host:port] [--clients K] [--observer] [--no-ack] [--add N]\n"
          << "                       [--move x,y,z --for T] [--duration T] [--json]\n\n"
          << "Example: fishtank-client --clients 8 --add 1000 --move 2,0,0 --for 1 --duration 5 --json\n\n"
          << flags;
@@ -91,6 +94,7 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   if (!std::isfinite(o.script.duration) || o.script.duration <= 0.0 || o.script.duration > 86400.0)
     return fail("--duration must be between 0 and 86400 seconds");
   o.script.clients = static_cast<int>(clients);
+  o.script.acknowledge = !no_ack;
   o.script.add = static_cast<std::uint32_t>(add);
   result.options = o;
   return result;

@@ -30,6 +30,7 @@ Summary summarise(const std::vector<std::shared_ptr<Connection>>& connections, d
     const ConnectionStats& st = c->stats();
     s.welcomed += c->welcomed();
     s.snapshots += st.snapshots;
+    s.keyframes += st.keyframes;
     s.bytes_per_s += st.bytes_received / seconds;
     if (st.snapshots >= 2)
       s.snapshot_rate_hz +=
@@ -78,6 +79,7 @@ Summary run_script(const Script& script) {
   for (int i = 0; i < script.clients; ++i) {
     connections.push_back(
         std::make_shared<Connection>(io, "fishtank-client-" + std::to_string(i + 1), !script.observer));
+    connections.back()->acknowledge_snapshots(script.acknowledge);
     connections.back()->start(server);
   }
 

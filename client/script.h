@@ -18,6 +18,7 @@ struct Script {
   std::uint16_t port = 7878;
   int clients = 1;
   bool observer = false;
+  bool acknowledge = true;  // false (--no-ack): every snapshot comes in full
   std::uint32_t add = 0;
   std::optional<Vec3> move;
   double move_for = 1.0;  // seconds
@@ -28,6 +29,7 @@ struct Summary {
   int clients = 0;
   int welcomed = 0;
   std::uint64_t snapshots = 0;    // total over all clients
+  std::uint64_t keyframes = 0;    // of those, the ones sent in full (the rest were deltas)
   double snapshot_rate_hz = 0.0;  // mean per client
   double bytes_per_s = 0.0;       // mean per client
   double rtt_ms = 0.0;            // median over every Pong; 0 without any

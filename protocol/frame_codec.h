@@ -14,7 +14,8 @@
 //      payload type that the receiving side accepts.
 // When decoding is ok, the payload table and every field a reader needs are
 // present (the Verifier alone allows them to be absent): Hello.client_name may
-// be null; everything else in fishtank.fbs may be dereferenced.
+// be null; a Snapshot has either positions or (a delta) unchanged and changes;
+// everything else in fishtank.fbs may be dereferenced.
 // A bad length or a failed verification breaks the stream (stream_broken()): the
 // reader cannot tell where the next frame starts, so it should disconnect.
 
@@ -29,6 +30,7 @@
 #include "common/tank.h"
 #include "common/vec3.h"
 #include "protocol/fishtank_generated.h"
+#include "protocol/snapshot_delta.h"
 
 namespace fishtank::protocol {
 
@@ -53,6 +55,7 @@ Frame encode_hello(std::string_view client_name, bool wants_player, std::uint32_
 Frame encode_player_input(std::uint32_t sequence, Vec3 velocity);
 Frame encode_add_balls(std::uint32_t count);
 Frame encode_ping(std::uint32_t client_time_us);
+Frame encode_ack(std::uint32_t tick, bool want_keyframe = false);
 
 // ---- encoding: server -> client ----
 struct WelcomeInfo {
@@ -83,6 +86,11 @@ struct SnapshotHeader {
 // player_ids and player_positions hold `players` entries each.
 Frame encode_snapshot(const SnapshotHeader& header, const std::uint16_t* quantised, std::uint32_t ball_count,
                       const std::uint32_t* player_ids, const Vec3* player_positions, std::size_t players);
+// The same snapshot with its positions coded against snapshot base_tick of
+// base_ball_count balls (protocol/snapshot_delta.h).
+Frame encode_delta_snapshot(const SnapshotHeader& header, std::uint32_t base_tick, std::uint32_t base_ball_count,
+                            const PositionsDelta& delta, std::uint32_t ball_count, const std::uint32_t* player_ids,
+                            const Vec3* player_positions, std::size_t players);
 
 Frame encode_error(wire::ErrorCode code, std::string_view message);
 Frame encode_pong(std::uint32_t client_time_us);

@@ -81,6 +81,12 @@ Outcome ClientProtocol::on_message(const wire::Message& message) {
     case wire::Payload::Ping:
       out.replies.push_back(protocol::encode_pong(message.payload_as_Ping()->client_time_us()));
       return out;
+    case wire::Payload::Ack: {
+      const wire::Ack& ack = *message.payload_as_Ack();
+      if (std::string why = acks_.acknowledged(ack.tick(), ack.want_keyframe()); !why.empty())
+        return refuse(wire::ErrorCode::invalid_value, why, /*disconnect=*/false);
+      return out;
+    }
     default:  // decode_frame accepts nothing else in this direction
       return refuse(wire::ErrorCode::unexpected_message, "message type not accepted by the server", false);
   }

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "protocol/frame_codec.h"
+#include "server/net/ack_tracker.h"
 #include "server/net/commands.h"
 
 namespace fishtank::net {
@@ -50,6 +51,11 @@ class ClientProtocol {
   // The command of an Outcome could not be queued (the physics is behind).
   Outcome on_queue_full();
 
+  // A Snapshot with this tick went out to the client.
+  void on_snapshot_sent(std::uint32_t tick) { acks_.sent(tick); }
+  // The snapshot the next one may be coded against; empty: send a keyframe.
+  std::optional<std::uint32_t> delta_base() const { return acks_.base(); }
+
   // True from the Welcome on: the client gets snapshots.
   bool welcomed() const { return state_ == State::active; }
   const std::string& client_name() const { return name_; }
@@ -65,6 +71,7 @@ class ClientProtocol {
   const ServerInfo& info_;
   State state_ = State::awaiting_hello;
   std::string name_;
+  AckTracker acks_;
 };
 
 }  // namespace fishtank::net

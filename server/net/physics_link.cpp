@@ -76,7 +76,6 @@ void PhysicsLink::publish_snapshot(const World& world, const LoopStatus& status)
   header.threads_stepping = static_cast<std::uint32_t>(status.threads);
   header.time_scale = static_cast<float>(status.time_scale);
   SharedSnapshot snapshot = encoder_.encode(world, header);
-  stats_.last_frame_bytes = snapshot->frame->size();
   stats_.encode_seconds += std::chrono::duration<double>(Clock::now() - start).count();
   ++stats_.encoded;
   publish_(std::move(snapshot));

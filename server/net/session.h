@@ -7,7 +7,9 @@
 //             replies          a short queue (bounded: a client that does not read is dropped)
 //             newest snapshot  one slot, overwritten by each new snapshot
 //   so a slow reader skips snapshots and never grows the server's memory or
-//   slows anyone else. Everything here runs on the io thread.
+//   slows anyone else. The snapshot is coded when its write starts, against
+//   the newest one the client acknowledged by then (a keyframe if none).
+//   Everything here runs on the io thread.
 
 #include <array>
 #include <boost/asio.hpp>
@@ -18,7 +20,7 @@
 #include <vector>
 
 #include "server/net/client_protocol.h"
-#include "server/net/snapshot_encoder.h"
+#include "server/net/snapshot_history.h"
 
 namespace fishtank::net {
 
@@ -32,6 +34,8 @@ class SessionOwner {
   virtual void session_welcomed(Session& session) = 0;
   virtual void session_closed(Session& session) = 0;
   virtual void bytes_sent(std::size_t bytes) = 0;
+  // The frame of snapshot for a client that holds snapshot `base` (empty: none).
+  virtual CodedSnapshot snapshot_frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base) = 0;
 };
 
 class Session : public std::enable_shared_from_this<Session> {
@@ -73,7 +77,7 @@ class Session : public std::enable_shared_from_this<Session> {
   // Kept alive while the write is in flight.
   std::vector<protocol::Frame> writing_replies_;
   protocol::Frame writing_kinds_;
-  SharedSnapshot writing_snapshot_;
+  protocol::SharedFrame writing_snapshot_;
   bool write_in_flight_ = false;
 
   bool close_after_write_ = false;

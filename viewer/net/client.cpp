@@ -201,6 +201,7 @@ void NetClient::on_welcome(const wire::Welcome& w) {
   info->player_id = w.player_id();
   info_ = info;
   kinds_ = std::make_shared<std::vector<std::uint8_t>>();
+  received_.clear();
   connected_ = true;
   snapshots_.clear();
   update_status([&](ConnectionStatus& s) {
@@ -226,6 +227,14 @@ void NetClient::on_ball_kinds(const wire::BallKinds& k) {
 void NetClient::on_snapshot(const wire::Snapshot& s) {
   if (s.ball_count() > kinds_->size()) return lose("the server sent balls of unknown kind");
   auto snap = std::make_shared<Snapshot>();
+  if (std::string why = received_.positions(s, snap->quantised); !why.empty()) {
+    send(protocol::encode_ack(s.tick(), /*want_keyframe=*/true));
+    return update_status([&](ConnectionStatus& st) {
+      st.notice = why + "; asked for a keyframe";
+      st.notice_time = steady_seconds();
+    });
+  }
+  send(protocol::encode_ack(s.tick()));
   snap->tick = s.tick();
   snap->sim_time = s.sim_time();
   snap->received = steady_seconds();
@@ -234,7 +243,6 @@ void NetClient::on_snapshot(const wire::Snapshot& s) {
   snap->threads_stepping = s.threads_stepping();
   snap->time_scale = s.time_scale();
   snap->ball_count = s.ball_count();
-  if (s.positions()) snap->quantised.assign(s.positions()->begin(), s.positions()->end());  // length checked
   snap->kinds = kinds_;
   if (s.player_ids())
     for (flatbuffers::uoffset_t i = 0; i < s.player_ids()->size(); ++i)

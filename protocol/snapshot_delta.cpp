@@ -1,0 +1,141 @@
+#include "protocol/snapshot_delta.h"
+
+#include <algorithm>
+
+namespace fishtank::protocol {
+
+namespace {
+
+// A difference of two 16-bit values zigzagged (0, -1, 1, -2, 2 ... -> 0, 1, 2, 3, 4 ...)
+// is below 2^17, so its exp-Golomb code has at most 17 leading zeros.
+constexpr int kMaxLeadingZeros = 17;
+
+std::uint32_t zigzag(std::int32_t d) {
+  return (static_cast<std::uint32_t>(d) << 1) ^ static_cast<std::uint32_t>(d >> 31);
+}
+std::int32_t unzigzag(std::uint32_t z) { return static_cast<std::int32_t>(z >> 1) ^ -static_cast<std::int32_t>(z & 1); }
+
+int floor_log2(std::uint32_t v) { return 31 - __builtin_clz(v); }
+
+class BitWriter {
+ public:
+  explicit BitWriter(std::vector<std::uint8_t>& out) : out_(out) {}
+
+  // bits <= 32
+  void put(std::uint32_t value, int bits) {
+    acc_ |= std::uint64_t{value} << fill_;
+    fill_ += bits;
+    for (; fill_ >= 8; fill_ -= 8, acc_ >>= 8) out_.push_back(static_cast<std::uint8_t>(acc_));
+  }
+  // n zeros, a one, then the n bits of v + 1 below its leading one.
+  void exp_golomb(std::uint32_t v) {
+    const std::uint32_t y = v + 1;
+    const int n = floor_log2(y);
+    put(1u << n, n + 1);
+    put(y & ((1u << n) - 1), n);
+  }
+  void flush() {
+    if (fill_ > 0) out_.push_back(static_cast<std::uint8_t>(acc_));
+    acc_ = 0;
+    fill_ = 0;
+  }
+
+ private:
+  std::vector<std::uint8_t>& out_;
+  std::uint64_t acc_ = 0;
+  int fill_ = 0;
+};
+
+class BitReader {
+ public:
+  BitReader(const std::uint8_t* data, std::size_t bytes) : data_(data), bits_(8 * std::uint64_t{bytes}) {}
+
+  // bits <= 32; false when the stream ends first.
+  bool get(int bits, std::uint32_t& value) {
+    if (pos_ + static_cast<std::uint64_t>(bits) > bits_) return false;
+    const std::size_t first = pos_ >> 3;
+    const std::size_t last = (pos_ + bits + 7) >> 3;  // one past the last byte touched (at most 5 bytes)
+    std::uint64_t word = 0;
+    for (std::size_t b = first; b < last; ++b) word |= std::uint64_t{data_[b]} << (8 * (b - first));
+    value = static_cast<std::uint32_t>((word >> (pos_ & 7)) & ((std::uint64_t{1} << bits) - 1));
+    pos_ += static_cast<std::uint64_t>(bits);
+    return true;
+  }
+  bool exp_golomb(std::uint32_t& v) {
+    int n = 0;
+    for (std::uint32_t bit = 0;; ++n) {
+      if (n > kMaxLeadingZeros || !get(1, bit)) return false;
+      if (bit) break;
+    }
+    std::uint32_t low = 0;
+    if (!get(n, low)) return false;
+    v = ((1u << n) | low) - 1;
+    return true;
+  }
+  // True when what is left is the zero padding of the last byte.
+  bool only_padding_left() {
+    std::uint32_t rest = 0;
+    const int left = static_cast<int>(bits_ - pos_);
+    return left < 8 && get(left, rest) && rest == 0;
+  }
+
+ private:
+  const std::uint8_t* data_;
+  std::uint64_t bits_;
+  std::uint64_t pos_ = 0;
+};
+
+}  // namespace
+
+void encode_positions_delta(const std::uint16_t* base, std::uint32_t base_count, const std::uint16_t* now,
+                            std::uint32_t count, PositionsDelta& out) {
+  const std::uint32_t common = std::min(base_count, count);
+  out.unchanged.assign(unchanged_mask_bytes(base_count, count), 0);
+  out.changes.clear();
+  BitWriter changes(out.changes);
+  for (std::uint32_t i = 0; i < common; ++i) {
+    const std::uint16_t* b = base + 3 * std::size_t{i};
+    const std::uint16_t* p = now + 3 * std::size_t{i};
+    if (b[0] == p[0] && b[1] == p[1] && b[2] == p[2]) {
+      out.unchanged[i >> 3] |= static_cast<std::uint8_t>(1u << (i & 7));
+      continue;
+    }
+    for (int axis = 0; axis < 3; ++axis) changes.exp_golomb(zigzag(std::int32_t{p[axis]} - std::int32_t{b[axis]}));
+  }
+  for (std::size_t v = 3 * std::size_t{common}; v < 3 * std::size_t{count}; ++v) changes.put(now[v], 16);
+  changes.flush();
+}
+
+std::string decode_positions_delta(const std::uint16_t* base, std::uint32_t base_count, const std::uint8_t* unchanged,
+                                   std::size_t unchanged_bytes, const std::uint8_t* changes, std::size_t changes_bytes,
+                                   std::uint32_t count, std::uint16_t* out) {
+  if (unchanged_bytes != unchanged_mask_bytes(base_count, count))
+    return "the unchanged mask has " + std::to_string(unchanged_bytes) + " bytes, " +
+           std::to_string(unchanged_mask_bytes(base_count, count)) + " expected";
+  const std::uint32_t common = std::min(base_count, count);
+  BitReader reader(changes, changes_bytes);
+  for (std::uint32_t i = 0; i < common; ++i) {
+    const std::uint16_t* b = base + 3 * std::size_t{i};
+    std::uint16_t* p = out + 3 * std::size_t{i};
+    if (unchanged[i >> 3] >> (i & 7) & 1) {
+      std::copy(b, b + 3, p);
+      continue;
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+      std::uint32_t z = 0;
+      if (!reader.exp_golomb(z)) return "the changes stream ends inside ball " + std::to_string(i);
+      const std::int32_t value = std::int32_t{b[axis]} + unzigzag(z);
+      if (value < 0 || value > 65535) return "ball " + std::to_string(i) + " moves outside the quantisation range";
+      p[axis] = static_cast<std::uint16_t>(value);
+    }
+  }
+  for (std::size_t v = 3 * std::size_t{common}; v < 3 * std::size_t{count}; ++v) {
+    std::uint32_t raw = 0;
+    if (!reader.get(16, raw)) return "the changes stream ends inside the new balls";
+    out[v] = static_cast<std::uint16_t>(raw);
+  }
+  if (!reader.only_padding_left()) return "the changes stream has bytes after its last ball";
+  return {};
+}
+
+}  // namespace fishtank::protocol

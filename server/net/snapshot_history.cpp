@@ -1,0 +1,67 @@
+#include "server/net/snapshot_history.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "protocol/received_snapshots.h"
+
+namespace fishtank::net {
+
+namespace {
+std::size_t bytes_of(const PublishedSnapshot& s) { return s.quantised.size() * sizeof(std::uint16_t); }
+}  // namespace
+
+void SnapshotHistory::publish(SharedSnapshot snapshot) {
+  kept_bytes_ += bytes_of(*snapshot);
+  kept_.push_back(std::move(snapshot));
+  while (kept_.size() > 1 && (kept_.size() > protocol::kKeptBases || kept_bytes_ > kMaxBytes)) {
+    kept_bytes_ -= bytes_of(*kept_.front());
+    kept_.pop_front();
+  }
+  cache_.clear();
+  stats_.snapshots.fetch_add(1, std::memory_order_relaxed);
+}
+
+const PublishedSnapshot* SnapshotHistory::find(std::uint32_t tick) const {
+  for (const SharedSnapshot& s : kept_)
+    if (s->header.tick == tick) return s.get();
+  return nullptr;
+}
+
+CodedSnapshot SnapshotHistory::frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base) {
+  const PublishedSnapshot* base_snapshot = base && *base < snapshot->header.tick ? find(*base) : nullptr;
+  if (!base_snapshot) base.reset();  // a keyframe
+  const bool newest = !kept_.empty() && kept_.back() == snapshot;
+  if (newest)
+    for (const auto& [cached_base, coded] : cache_)
+      if (cached_base == base) return coded;
+  CodedSnapshot coded = code(*snapshot, base_snapshot);
+  if (newest) cache_.emplace_back(base, coded);
+  return coded;
+}
+
+CodedSnapshot SnapshotHistory::code(const PublishedSnapshot& s, const PublishedSnapshot* base) {
+  const auto start = std::chrono::steady_clock::now();
+  CodedSnapshot coded;
+  coded.keyframe = base == nullptr;
+  if (coded.keyframe) {
+    coded.frame = std::make_shared<const protocol::Frame>(
+        protocol::encode_snapshot(s.header, s.quantised.data(), s.ball_count, s.player_ids.data(),
+                                  s.player_positions.data(), s.player_ids.size()));
+  } else {
+    protocol::encode_positions_delta(base->quantised.data(), base->ball_count, s.quantised.data(), s.ball_count,
+                                     delta_);
+    coded.frame = std::make_shared<const protocol::Frame>(
+        protocol::encode_delta_snapshot(s.header, base->header.tick, base->ball_count, delta_, s.ball_count,
+                                        s.player_ids.data(), s.player_positions.data(), s.player_ids.size()));
+  }
+  const auto ns =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
+  stats_.frames.fetch_add(1, std::memory_order_relaxed);
+  stats_.keyframes.fetch_add(coded.keyframe, std::memory_order_relaxed);
+  stats_.coding_ns.fetch_add(static_cast<std::uint64_t>(ns), std::memory_order_relaxed);
+  stats_.frame_bytes.fetch_add(coded.frame->size(), std::memory_order_relaxed);
+  return coded;
+}
+
+}  // namespace fishtank::net
