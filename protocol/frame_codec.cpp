@@ -1,5 +1,6 @@
 #include "protocol/frame_codec.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -57,6 +58,11 @@ std::string check_positions(const wire::Snapshot& s) {
     if (s.unchanged()->size() != expected)
       return "delta Snapshot has an unchanged mask of " + std::to_string(s.unchanged()->size()) + " bytes for " +
              std::to_string(expected) + " bytes of balls (truncated or overlong)";
+    // Checked here, before a reader allocates ball_count positions (found by fuzzing).
+    const std::uint64_t new_balls = s.ball_count() - std::min(s.base_ball_count(), s.ball_count());
+    if (new_balls * 6 > s.changes()->size())
+      return "delta Snapshot has " + std::to_string(new_balls) + " new balls but only " +
+             std::to_string(s.changes()->size()) + " bytes of changes (6 per new ball at least)";
     return {};
   }
   if (!s.positions()) return "Snapshot lacks its positions vector";

@@ -28,6 +28,12 @@ int main(int argc, char** argv) {
   protocol::SnapshotHeader header;
   header.tick = 5;
   header.sim_time = 1.25;
+  // The next snapshot as a delta against this one: one ball still, one moved, one new.
+  const std::uint16_t next[12] = {0, 100, 65535, 32769, 1, 0, 2, 3, 4, 7, 8, 9};
+  protocol::PositionsDelta delta;
+  protocol::encode_positions_delta(positions, 3, next, 4, delta);
+  protocol::SnapshotHeader next_header = header;
+  next_header.tick = 6;
 
   const std::vector<std::pair<std::string, protocol::Frame>> frames = {
       {"hello", protocol::encode_hello("seed", true)},
@@ -40,11 +46,19 @@ int main(int argc, char** argv) {
       {"snapshot", protocol::encode_snapshot(header, positions, 3, player_ids, players, 1)},
       {"error", protocol::encode_error(wire::ErrorCode::tank_full, "added 10 of 20 balls")},
       {"pong", protocol::encode_pong(123456)},
+      {"ack", protocol::encode_ack(5)},
+      {"ack_keyframe", protocol::encode_ack(7, true)},
+      {"delta_snapshot", protocol::encode_delta_snapshot(next_header, 5, 3, delta, 4, player_ids, players, 1)},
   };
   protocol::Frame conversation{0};  // chunk byte 0: one byte at a time
-  for (const char* name : {"hello", "player_input", "add_balls", "ping"})
+  for (const char* name : {"hello", "player_input", "add_balls", "ping", "ack", "ack_keyframe"})
     for (const auto& [n, f] : frames)
       if (n == name) conversation.insert(conversation.end(), f.begin(), f.end());
+  // What a client reads: a keyframe, then a delta against it.
+  protocol::Frame snapshots{63};
+  for (const char* name : {"snapshot", "delta_snapshot"})
+    for (const auto& [n, f] : frames)
+      if (n == name) snapshots.insert(snapshots.end(), f.begin(), f.end());
 
   const std::string dir = argv[1];
   for (const auto& [name, frame] : frames) {
@@ -55,5 +69,7 @@ int main(int argc, char** argv) {
   }
   std::ofstream(dir + "/conversation", std::ios::binary)
       .write(reinterpret_cast<const char*>(conversation.data()), static_cast<std::streamsize>(conversation.size()));
+  std::ofstream(dir + "/keyframe_then_delta", std::ios::binary)
+      .write(reinterpret_cast<const char*>(snapshots.data()), static_cast<std::streamsize>(snapshots.size()));
   return 0;
 }

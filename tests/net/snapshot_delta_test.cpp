@@ -182,6 +182,10 @@ TEST_CASE("delta snapshots whose shape is wrong are invalid before anyone reads 
     CHECK(r.status == DecodeStatus::invalid_value);
     CHECK_THAT(r.why, Catch::Contains("unchanged mask"));
   }
+  SECTION("more new balls than its changes could hold (a huge ball count; found by fuzzing)") {
+    CHECK(decode(protocol::encode_delta_snapshot(h, 0, 100, d, 4'000'000'000u, nullptr, nullptr, 0)).status ==
+          DecodeStatus::invalid_value);
+  }
   SECTION("a mask for a base of another size") {
     CHECK(decode(protocol::encode_delta_snapshot(h, 0, 200, d, 300, nullptr, nullptr, 0)).status ==
           DecodeStatus::invalid_value);
