@@ -55,7 +55,9 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
       "move", po::value(&move), "player sphere velocity x,y,z in m/s (every client with a sphere)")(
       "for", po::value(&o.script.move_for)->default_value(o.script.move_for), "seconds to move before stopping")(
       "duration", po::value(&o.script.duration)->default_value(o.script.duration), "seconds to stay connected")(
-      "json", po::bool_switch(&o.json), "print one JSON summary on stdout");
+      "every", po::value(&o.script.every)->default_value(0.0),
+      "also report what was received every this many seconds (0: only the summary)")(
+      "json", po::bool_switch(&o.json), "print one JSON summary on stdout (and one JSON line per --every interval)");
 
   ClientParse result;
   auto fail = [&result](const std::string& why) {
@@ -74,7 +76,7 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
     std::ostringstream help;
     help << "fishtank-client: connects to a fishtank-server, runs a short script and reports what it received.\n\n"
          << "Usage: fishtank-client [--connect host:port] [--clients K] [--observer] [--no-ack] [--add N]\n"
-         << "                       [--move x,y,z --for T] [--duration T] [--json]\n\n"
+         << "                       [--move x,y,z --for T] [--duration T] [--every T] [--json]\n\n"
          << "Example: fishtank-client --clients 8 --add 1000 --move 2,0,0 --for 1 --duration 5 --json\n\n"
          << flags;
     result.message = help.str();
@@ -93,6 +95,7 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   if (!std::isfinite(o.script.move_for) || o.script.move_for < 0.0) return fail("--for must be seconds >= 0");
   if (!std::isfinite(o.script.duration) || o.script.duration <= 0.0 || o.script.duration > 86400.0)
     return fail("--duration must be between 0 and 86400 seconds");
+  if (!std::isfinite(o.script.every) || o.script.every < 0.0) return fail("--every must be seconds >= 0");
   o.script.clients = static_cast<int>(clients);
   o.script.acknowledge = !no_ack;
   o.script.add = static_cast<std::uint32_t>(add);

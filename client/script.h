@@ -5,6 +5,7 @@
 // --duration seconds everything is summed up.
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,6 +24,14 @@ struct Script {
   std::optional<Vec3> move;
   double move_for = 1.0;  // seconds
   double duration = 3.0;  // seconds
+  double every = 0.0;     // seconds between interval reports; 0: none
+};
+
+// What every connection received in one --every interval, summed.
+struct IntervalReport {
+  double t = 0.0;           // seconds since the start, at the end of the interval
+  std::uint32_t balls = 0;  // in the newest snapshot
+  std::uint64_t snapshots = 0, keyframes = 0, bytes = 0;
 };
 
 struct Summary {
@@ -49,6 +58,7 @@ struct Summary {
   int dropped = 0;
 };
 
-Summary run_script(const Script& script);
+// on_interval is called every script.every seconds (when that is > 0).
+Summary run_script(const Script& script, const std::function<void(const IntervalReport&)>& on_interval = {});
 
 }  // namespace fishtank::client

@@ -43,14 +43,17 @@ CodedSnapshot SnapshotHistory::frame(const SharedSnapshot& snapshot, std::option
 CodedSnapshot SnapshotHistory::code(const PublishedSnapshot& s, const PublishedSnapshot* base) {
   const auto start = std::chrono::steady_clock::now();
   CodedSnapshot coded;
-  coded.keyframe = base == nullptr;
+  if (base)
+    protocol::encode_positions_delta(base->quantised.data(), base->ball_count, s.quantised.data(), s.ball_count,
+                                     delta_);
+  // Balls that all jumped far code longer than in full: then the full snapshot, so
+  // no frame is ever larger than a keyframe (kMaxServerFrameBytes holds).
+  coded.keyframe = !base || delta_.unchanged.size() + delta_.changes.size() >= s.quantised.size() * 2;
   if (coded.keyframe) {
     coded.frame = std::make_shared<const protocol::Frame>(
         protocol::encode_snapshot(s.header, s.quantised.data(), s.ball_count, s.player_ids.data(),
                                   s.player_positions.data(), s.player_ids.size()));
   } else {
-    protocol::encode_positions_delta(base->quantised.data(), base->ball_count, s.quantised.data(), s.ball_count,
-                                     delta_);
     coded.frame = std::make_shared<const protocol::Frame>(
         protocol::encode_delta_snapshot(s.header, base->header.tick, base->ball_count, delta_, s.ball_count,
                                         s.player_ids.data(), s.player_positions.data(), s.player_ids.size()));

@@ -178,3 +178,23 @@ TEST_CASE("an Ack the client cannot have meant gets an Error, then a keyframe; t
     CHECK(conversation.delta_base() == 11u);
   }
 }
+
+TEST_CASE("a delta that would be larger than the full snapshot is sent in full", "[net][delta]") {
+  net::SnapshotHistory history;
+  const auto snapshot_at = [](std::uint32_t tick, std::uint16_t value) {
+    auto s = std::make_shared<net::PublishedSnapshot>();
+    s->header.tick = tick;
+    s->ball_count = 100;
+    s->quantised.assign(300, value);
+    return net::SharedSnapshot(s);
+  };
+  history.publish(snapshot_at(0, 0));
+  const net::SharedSnapshot jumped = snapshot_at(1, 65535);  // every ball across the tank: 35 bits per axis
+  history.publish(jumped);
+  const net::CodedSnapshot coded = history.frame(jumped, 0);
+  CHECK(coded.keyframe);
+  const protocol::DecodeResult r =
+      protocol::decode_frame(coded.frame->data(), coded.frame->size(), Direction::to_client);
+  REQUIRE(r.ok());
+  CHECK(r.message->payload_as_Snapshot()->positions()->size() == 300);
+}
