@@ -231,24 +231,25 @@ Frame encode_snapshot(const SnapshotHeader& header, const std::uint16_t* quantis
       [&](flatbuffers::FlatBufferBuilder& b) { return Full{b.CreateVector(quantised, values)}; });
 }
 
-Frame encode_delta_snapshot(const SnapshotHeader& header, std::uint32_t base_tick, std::uint32_t base_ball_count,
-                            const PositionsDelta& delta, std::uint32_t ball_count, const std::uint32_t* player_ids,
-                            const Vec3* player_positions, std::size_t players) {
+Frame encode_delta_snapshot(const SnapshotHeader& header, const DeltaReference& ref, const PositionsDelta& delta,
+                            std::uint32_t ball_count, const std::uint32_t* player_ids, const Vec3* player_positions,
+                            std::size_t players) {
   struct Delta {
-    std::uint32_t base_tick, base_ball_count;
+    const DeltaReference& ref;
     flatbuffers::Offset<flatbuffers::Vector<std::uint8_t>> unchanged, changes;
     void add_to(wire::SnapshotBuilder& s) const {
-      s.add_base_tick(base_tick);
-      s.add_base_ball_count(base_ball_count);
+      s.add_base_tick(ref.base_tick);
+      s.add_base_ball_count(ref.base_count);
       s.add_unchanged(unchanged);
       s.add_changes(changes);
+      s.add_prior_tick(ref.prior_tick);
+      s.add_predicted(ref.prior != nullptr);
     }
   };
-  return encode_snapshot_with(
-      header, ball_count, player_ids, player_positions, players, delta.unchanged.size() + delta.changes.size(),
-      [&](flatbuffers::FlatBufferBuilder& b) {
-        return Delta{base_tick, base_ball_count, b.CreateVector(delta.unchanged), b.CreateVector(delta.changes)};
-      });
+  return encode_snapshot_with(header, ball_count, player_ids, player_positions, players,
+                              delta.unchanged.size() + delta.changes.size(), [&](flatbuffers::FlatBufferBuilder& b) {
+                                return Delta{ref, b.CreateVector(delta.unchanged), b.CreateVector(delta.changes)};
+                              });
 }
 
 Frame encode_error(wire::ErrorCode code, std::string_view message) {

@@ -86,11 +86,10 @@ struct SnapshotHeader {
 // player_ids and player_positions hold `players` entries each.
 Frame encode_snapshot(const SnapshotHeader& header, const std::uint16_t* quantised, std::uint32_t ball_count,
                       const std::uint32_t* player_ids, const Vec3* player_positions, std::size_t players);
-// The same snapshot with its positions coded against snapshot base_tick of
-// base_ball_count balls (protocol/snapshot_delta.h).
-Frame encode_delta_snapshot(const SnapshotHeader& header, std::uint32_t base_tick, std::uint32_t base_ball_count,
-                            const PositionsDelta& delta, std::uint32_t ball_count, const std::uint32_t* player_ids,
-                            const Vec3* player_positions, std::size_t players);
+// The same snapshot with its positions coded against `ref` (protocol/snapshot_delta.h).
+Frame encode_delta_snapshot(const SnapshotHeader& header, const DeltaReference& ref, const PositionsDelta& delta,
+                            std::uint32_t ball_count, const std::uint32_t* player_ids, const Vec3* player_positions,
+                            std::size_t players);
 
 Frame encode_error(wire::ErrorCode code, std::string_view message);
 Frame encode_pong(std::uint32_t client_time_us);

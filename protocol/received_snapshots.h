@@ -2,7 +2,8 @@
 // A client's side of delta snapshots (protocol/snapshot_delta.h): it rebuilds
 // each Snapshot's positions, full or delta, and keeps the newest few as the
 // bases the server may code against (it codes against the newest one this
-// client acknowledged, and never against one older than kKeptBases snapshots).
+// client acknowledged, and the one it sent before that, never older than
+// kKeptBases snapshots).
 // Used by fishtank-viewer and fishtank-client alike.
 //
 //   Snapshot ─► positions(s, out) ─ok─► Ack(s.tick)            base kept
@@ -35,6 +36,7 @@ class ReceivedSnapshots {
     std::uint32_t tick;
     std::vector<std::uint16_t> positions;
   };
+  const Kept* find(std::uint32_t tick) const;
   std::deque<Kept> kept_;  // oldest first
 };
 

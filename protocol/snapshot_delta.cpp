@@ -85,46 +85,70 @@ class BitReader {
   std::uint64_t pos_ = 0;
 };
 
+// Where ball i is expected in snapshot `tick`: its base position, carried on at
+// its velocity from prior to base when that was more than jitter.
+void predict(const DeltaReference& ref, std::uint32_t tick, std::uint32_t i, std::int32_t out[3]) {
+  const std::uint16_t* b = ref.base + 3 * std::size_t{i};
+  for (int axis = 0; axis < 3; ++axis) out[axis] = b[axis];
+  const std::int64_t ahead = std::int64_t{tick} - ref.base_tick, behind = std::int64_t{ref.base_tick} - ref.prior_tick;
+  if (!ref.prior || i >= ref.prior_count || ahead <= 0 || behind <= 0) return;
+  const std::uint16_t* a = ref.prior + 3 * std::size_t{i};
+  std::int64_t moved[3];
+  bool moving = false;
+  for (int axis = 0; axis < 3; ++axis) {
+    moved[axis] = std::int64_t{b[axis]} - a[axis];
+    moving = moving || moved[axis] >= kMovingQuanta || moved[axis] <= -kMovingQuanta;
+  }
+  if (!moving) return;
+  // Integer arithmetic, truncating, so that server and client predict the same value.
+  for (int axis = 0; axis < 3; ++axis)
+    out[axis] = static_cast<std::int32_t>(std::clamp<std::int64_t>(b[axis] + moved[axis] * ahead / behind, 0, 65535));
+}
+
 }  // namespace
 
-void encode_positions_delta(const std::uint16_t* base, std::uint32_t base_count, const std::uint16_t* now,
+void encode_positions_delta(const DeltaReference& ref, std::uint32_t tick, const std::uint16_t* now,
                             std::uint32_t count, PositionsDelta& out) {
-  const std::uint32_t common = std::min(base_count, count);
-  out.unchanged.assign(unchanged_mask_bytes(base_count, count), 0);
+  const std::uint32_t common = std::min(ref.base_count, count);
+  out.unchanged.assign(unchanged_mask_bytes(ref.base_count, count), 0);
   out.changes.clear();
   BitWriter changes(out.changes);
   for (std::uint32_t i = 0; i < common; ++i) {
-    const std::uint16_t* b = base + 3 * std::size_t{i};
+    const std::uint16_t* b = ref.base + 3 * std::size_t{i};
     const std::uint16_t* p = now + 3 * std::size_t{i};
     if (b[0] == p[0] && b[1] == p[1] && b[2] == p[2]) {
       out.unchanged[i >> 3] |= static_cast<std::uint8_t>(1u << (i & 7));
       continue;
     }
-    for (int axis = 0; axis < 3; ++axis) changes.exp_golomb(zigzag(std::int32_t{p[axis]} - std::int32_t{b[axis]}));
+    std::int32_t expected[3];
+    predict(ref, tick, i, expected);
+    for (int axis = 0; axis < 3; ++axis) changes.exp_golomb(zigzag(std::int32_t{p[axis]} - expected[axis]));
   }
   for (std::size_t v = 3 * std::size_t{common}; v < 3 * std::size_t{count}; ++v) changes.put(now[v], 16);
   changes.flush();
 }
 
-std::string decode_positions_delta(const std::uint16_t* base, std::uint32_t base_count, const std::uint8_t* unchanged,
+std::string decode_positions_delta(const DeltaReference& ref, std::uint32_t tick, const std::uint8_t* unchanged,
                                    std::size_t unchanged_bytes, const std::uint8_t* changes, std::size_t changes_bytes,
                                    std::uint32_t count, std::uint16_t* out) {
-  if (unchanged_bytes != unchanged_mask_bytes(base_count, count))
+  if (unchanged_bytes != unchanged_mask_bytes(ref.base_count, count))
     return "the unchanged mask has " + std::to_string(unchanged_bytes) + " bytes, " +
-           std::to_string(unchanged_mask_bytes(base_count, count)) + " expected";
-  const std::uint32_t common = std::min(base_count, count);
+           std::to_string(unchanged_mask_bytes(ref.base_count, count)) + " expected";
+  const std::uint32_t common = std::min(ref.base_count, count);
   BitReader reader(changes, changes_bytes);
   for (std::uint32_t i = 0; i < common; ++i) {
-    const std::uint16_t* b = base + 3 * std::size_t{i};
+    const std::uint16_t* b = ref.base + 3 * std::size_t{i};
     std::uint16_t* p = out + 3 * std::size_t{i};
     if (unchanged[i >> 3] >> (i & 7) & 1) {
       std::copy(b, b + 3, p);
       continue;
     }
+    std::int32_t expected[3];
+    predict(ref, tick, i, expected);
     for (int axis = 0; axis < 3; ++axis) {
       std::uint32_t z = 0;
       if (!reader.exp_golomb(z)) return "the changes stream ends inside ball " + std::to_string(i);
-      const std::int32_t value = std::int32_t{b[axis]} + unzigzag(z);
+      const std::int32_t value = expected[axis] + unzigzag(z);
       if (value < 0 || value > 65535) return "ball " + std::to_string(i) + " moves outside the quantisation range";
       p[axis] = static_cast<std::uint16_t>(value);
     }

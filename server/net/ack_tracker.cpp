@@ -32,4 +32,11 @@ std::string AckTracker::acknowledged(std::uint32_t tick, bool want_keyframe) {
   return {};
 }
 
+std::optional<std::uint32_t> AckTracker::prior() const {
+  if (!base_) return std::nullopt;
+  const auto at = std::lower_bound(sent_.begin(), sent_.end(), *base_);
+  if (at == sent_.begin() || at == sent_.end() || *at != *base_) return std::nullopt;
+  return *(at - 1);
+}
+
 }  // namespace fishtank::net

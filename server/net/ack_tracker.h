@@ -20,6 +20,8 @@ class AckTracker {
   std::string acknowledged(std::uint32_t tick, bool want_keyframe);
   // Empty: the next snapshot must be a keyframe.
   std::optional<std::uint32_t> base() const { return base_; }
+  // The snapshot sent before base(), which the client holds too; empty when none is known.
+  std::optional<std::uint32_t> prior() const;
 
  private:
   std::deque<std::uint32_t> sent_;  // the newest kKeptBases ticks sent, oldest first

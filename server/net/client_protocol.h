@@ -55,6 +55,8 @@ class ClientProtocol {
   void on_snapshot_sent(std::uint32_t tick) { acks_.sent(tick); }
   // The snapshot the next one may be coded against; empty: send a keyframe.
   std::optional<std::uint32_t> delta_base() const { return acks_.base(); }
+  // The snapshot sent before that one, to predict moving balls from; empty: none.
+  std::optional<std::uint32_t> delta_prior() const { return acks_.prior(); }
 
   // True from the Welcome on: the client gets snapshots.
   bool welcomed() const { return state_ == State::active; }

@@ -42,8 +42,9 @@ class NetServer final : public SessionOwner {
   void session_welcomed(Session& session) override;
   void session_closed(Session& session) override;
   void bytes_sent(std::size_t bytes) override;
-  CodedSnapshot snapshot_frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base) override {
-    return history_.frame(snapshot, base);
+  CodedSnapshot snapshot_frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base,
+                               std::optional<std::uint32_t> prior) override {
+    return history_.frame(snapshot, base, prior);
   }
   // Coding of snapshot frames so far; safe to read from any thread.
   const FrameStats& frame_stats() const { return history_.stats(); }

@@ -85,7 +85,7 @@ void Session::do_write() {
       kinds_sent_ = balls;
       buffers.push_back(asio::buffer(writing_kinds_));
     }
-    writing_snapshot_ = owner_.snapshot_frame(snapshot, protocol_.delta_base()).frame;
+    writing_snapshot_ = owner_.snapshot_frame(snapshot, protocol_.delta_base(), protocol_.delta_prior()).frame;
     protocol_.on_snapshot_sent(snapshot->header.tick);
     buffers.push_back(asio::buffer(*writing_snapshot_));
   }

@@ -34,8 +34,9 @@ class SessionOwner {
   virtual void session_welcomed(Session& session) = 0;
   virtual void session_closed(Session& session) = 0;
   virtual void bytes_sent(std::size_t bytes) = 0;
-  // The frame of snapshot for a client that holds snapshot `base` (empty: none).
-  virtual CodedSnapshot snapshot_frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base) = 0;
+  // The frame of snapshot for a client that holds snapshots `base` (empty: none) and `prior`.
+  virtual CodedSnapshot snapshot_frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base,
+                                       std::optional<std::uint32_t> prior) = 0;
 };
 
 class Session : public std::enable_shared_from_this<Session> {

@@ -28,24 +28,38 @@ const PublishedSnapshot* SnapshotHistory::find(std::uint32_t tick) const {
   return nullptr;
 }
 
-CodedSnapshot SnapshotHistory::frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base) {
+CodedSnapshot SnapshotHistory::frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base,
+                                     std::optional<std::uint32_t> prior) {
   const PublishedSnapshot* base_snapshot = base && *base < snapshot->header.tick ? find(*base) : nullptr;
+  const PublishedSnapshot* prior_snapshot = base_snapshot && prior && *prior < *base ? find(*prior) : nullptr;
   if (!base_snapshot) base.reset();  // a keyframe
+  if (!prior_snapshot) prior.reset();
+  const References references{base, prior};
   const bool newest = !kept_.empty() && kept_.back() == snapshot;
   if (newest)
-    for (const auto& [cached_base, coded] : cache_)
-      if (cached_base == base) return coded;
-  CodedSnapshot coded = code(*snapshot, base_snapshot);
-  if (newest) cache_.emplace_back(base, coded);
+    for (const auto& [cached, coded] : cache_)
+      if (cached == references) return coded;
+  CodedSnapshot coded = code(*snapshot, base_snapshot, prior_snapshot);
+  if (newest) cache_.emplace_back(references, coded);
   return coded;
 }
 
-CodedSnapshot SnapshotHistory::code(const PublishedSnapshot& s, const PublishedSnapshot* base) {
+CodedSnapshot SnapshotHistory::code(const PublishedSnapshot& s, const PublishedSnapshot* base,
+                                    const PublishedSnapshot* prior) {
   const auto start = std::chrono::steady_clock::now();
   CodedSnapshot coded;
-  if (base)
-    protocol::encode_positions_delta(base->quantised.data(), base->ball_count, s.quantised.data(), s.ball_count,
-                                     delta_);
+  protocol::DeltaReference ref;
+  if (base) {
+    ref.base = base->quantised.data();
+    ref.base_count = base->ball_count;
+    ref.base_tick = base->header.tick;
+    if (prior) {
+      ref.prior = prior->quantised.data();
+      ref.prior_count = prior->ball_count;
+      ref.prior_tick = prior->header.tick;
+    }
+    protocol::encode_positions_delta(ref, s.header.tick, s.quantised.data(), s.ball_count, delta_);
+  }
   // Balls that all jumped far code longer than in full: then the full snapshot, so
   // no frame is ever larger than a keyframe (kMaxServerFrameBytes holds).
   coded.keyframe = !base || delta_.unchanged.size() + delta_.changes.size() >= s.quantised.size() * 2;
@@ -54,9 +68,8 @@ CodedSnapshot SnapshotHistory::code(const PublishedSnapshot& s, const PublishedS
         protocol::encode_snapshot(s.header, s.quantised.data(), s.ball_count, s.player_ids.data(),
                                   s.player_positions.data(), s.player_ids.size()));
   } else {
-    coded.frame = std::make_shared<const protocol::Frame>(
-        protocol::encode_delta_snapshot(s.header, base->header.tick, base->ball_count, delta_, s.ball_count,
-                                        s.player_ids.data(), s.player_positions.data(), s.player_ids.size()));
+    coded.frame = std::make_shared<const protocol::Frame>(protocol::encode_delta_snapshot(
+        s.header, ref, delta_, s.ball_count, s.player_ids.data(), s.player_positions.data(), s.player_ids.size()));
   }
   const auto ns =
       std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();

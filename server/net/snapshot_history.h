@@ -2,7 +2,7 @@
 // The io thread's store of recent snapshots, and the frames of the newest one.
 //
 //   physics thread ─► publish(s) ─► [ newest kKeptBases snapshots ]   the bases
-//   session ─► frame(newest, base) ─► cache hit? ─► the same frame for every client with that base
+//   session ─► frame(newest, base, prior) ─► cache hit? ─► the same frame for every client with that base
 //                                     └ miss: code a delta against base (or a keyframe: no base,
 //                                       or one no longer kept), keep it for the next client
 //
@@ -43,18 +43,21 @@ class SnapshotHistory {
   static constexpr std::size_t kMaxBytes = std::size_t{256} << 20;
 
   void publish(SharedSnapshot snapshot);
-  // The frame of `snapshot` for a client that holds `base` (empty: none).
-  CodedSnapshot frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base);
+  // The frame of `snapshot` for a client that holds `base` (empty: none) and
+  // `prior`, the snapshot sent to it before base (empty: none).
+  CodedSnapshot frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base,
+                      std::optional<std::uint32_t> prior = std::nullopt);
   const FrameStats& stats() const { return stats_; }
 
  private:
   const PublishedSnapshot* find(std::uint32_t tick) const;
-  CodedSnapshot code(const PublishedSnapshot& snapshot, const PublishedSnapshot* base);
+  CodedSnapshot code(const PublishedSnapshot& snapshot, const PublishedSnapshot* base, const PublishedSnapshot* prior);
 
   std::deque<SharedSnapshot> kept_;  // oldest first; the newest published is last
   std::size_t kept_bytes_ = 0;
-  // Frames of the newest snapshot, by the base they were coded against (empty: keyframe).
-  std::vector<std::pair<std::optional<std::uint32_t>, CodedSnapshot>> cache_;
+  // Frames of the newest snapshot, by the base and prior they were coded against (empty: none).
+  using References = std::pair<std::optional<std::uint32_t>, std::optional<std::uint32_t>>;
+  std::vector<std::pair<References, CodedSnapshot>> cache_;
   protocol::PositionsDelta delta_;  // scratch
   FrameStats stats_;
 };

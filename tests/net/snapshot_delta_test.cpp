@@ -38,27 +38,40 @@ Pair random_pair(std::uint32_t count, std::uint32_t added, std::uint32_t seed) {
   return p;
 }
 
+// A base of `base` (and a prior, when given, one tick before) at tick `tick`.
+protocol::DeltaReference reference(const std::vector<std::uint16_t>& base, std::uint32_t tick = 0,
+                                   const std::vector<std::uint16_t>* prior = nullptr) {
+  protocol::DeltaReference ref;
+  ref.base = base.data();
+  ref.base_count = static_cast<std::uint32_t>(base.size() / 3);
+  ref.base_tick = tick;
+  if (prior) {
+    ref.prior = prior->data();
+    ref.prior_count = static_cast<std::uint32_t>(prior->size() / 3);
+    ref.prior_tick = tick - 1;
+  }
+  return ref;
+}
+
 std::vector<std::uint16_t> round_trip(const std::vector<std::uint16_t>& base, const std::vector<std::uint16_t>& now,
                                       std::string& why) {
   protocol::PositionsDelta d;
-  const auto base_count = static_cast<std::uint32_t>(base.size() / 3),
-             count = static_cast<std::uint32_t>(now.size() / 3);
-  protocol::encode_positions_delta(base.data(), base_count, now.data(), count, d);
+  const auto count = static_cast<std::uint32_t>(now.size() / 3);
+  protocol::encode_positions_delta(reference(base), 1, now.data(), count, d);
   std::vector<std::uint16_t> out(now.size());
-  why = protocol::decode_positions_delta(base.data(), base_count, d.unchanged.data(), d.unchanged.size(),
-                                         d.changes.data(), d.changes.size(), count, out.data());
+  why = protocol::decode_positions_delta(reference(base), 1, d.unchanged.data(), d.unchanged.size(), d.changes.data(),
+                                         d.changes.size(), count, out.data());
   return out;
 }
 
 protocol::Frame delta_frame(std::uint32_t tick, std::uint32_t base_tick, const std::vector<std::uint16_t>& base,
                             const std::vector<std::uint16_t>& now) {
   protocol::PositionsDelta d;
-  const auto base_count = static_cast<std::uint32_t>(base.size() / 3),
-             count = static_cast<std::uint32_t>(now.size() / 3);
-  protocol::encode_positions_delta(base.data(), base_count, now.data(), count, d);
+  const auto count = static_cast<std::uint32_t>(now.size() / 3);
+  protocol::encode_positions_delta(reference(base, base_tick), tick, now.data(), count, d);
   protocol::SnapshotHeader h;
   h.tick = tick;
-  return protocol::encode_delta_snapshot(h, base_tick, base_count, d, count, nullptr, nullptr, 0);
+  return protocol::encode_delta_snapshot(h, reference(base, base_tick), d, count, nullptr, nullptr, 0);
 }
 
 protocol::Frame full_frame(std::uint32_t tick, const std::vector<std::uint16_t>& q) {
@@ -101,12 +114,35 @@ TEST_CASE("balls at rest cost one bit; a quantum of jitter a few more", "[protoc
   std::vector<std::uint16_t> base(3 * 8000, 30000);
   std::vector<std::uint16_t> now = base;
   protocol::PositionsDelta d;
-  protocol::encode_positions_delta(base.data(), 8000, now.data(), 8000, d);
+  protocol::encode_positions_delta(reference(base), 1, now.data(), 8000, d);
   CHECK(d.unchanged.size() == 1000);
   CHECK(d.changes.empty());
   for (std::size_t b = 0; b < 8000; b += 4) ++now[3 * b + 1];  // a quarter of the balls up one quantum
-  protocol::encode_positions_delta(base.data(), 8000, now.data(), 8000, d);
+  protocol::encode_positions_delta(reference(base), 1, now.data(), 8000, d);
   CHECK(d.changes.size() == 2000 * 5 / 8);  // 1 + 3 + 1 bits each
+}
+
+TEST_CASE("a ball that was moving costs only its change of velocity, and comes back exactly", "[protocol][delta]") {
+  // 1000 balls falling faster each snapshot (900 quanta, then 4 more: gravity) and drifting 7 along x.
+  std::vector<std::uint16_t> prior, base, now;
+  for (int b = 0; b < 1000; ++b) {
+    int k = 0;
+    for (std::vector<std::uint16_t>* s : {&prior, &base, &now}) {
+      s->insert(s->end(), {static_cast<std::uint16_t>(1000 + 30 * b + 7 * k),
+                           static_cast<std::uint16_t>(60000 - 900 * k - 2 * k * k), 30000});
+      ++k;
+    }
+  }
+  protocol::PositionsDelta predicted, plain;
+  protocol::encode_positions_delta(reference(base, 5, &prior), 6, now.data(), 1000, predicted);
+  protocol::encode_positions_delta(reference(base, 5), 6, now.data(), 1000, plain);
+  CHECK(predicted.changes.size() * 3 < plain.changes.size());
+  std::vector<std::uint16_t> out(now.size());
+  CHECK(protocol::decode_positions_delta(reference(base, 5, &prior), 6, predicted.unchanged.data(),
+                                         predicted.unchanged.size(), predicted.changes.data(), predicted.changes.size(),
+                                         1000, out.data())
+            .empty());
+  CHECK(out == now);
 }
 
 TEST_CASE("a client rebuilds deltas from the bases it kept and refuses those it cannot", "[protocol][delta]") {
@@ -121,6 +157,16 @@ TEST_CASE("a client rebuilds deltas from the bases it kept and refuses those it 
     const protocol::Frame f = delta_frame(11, 10, p.base, p.now);
     CHECK(client.positions(snapshot_of(f), out).empty());
     CHECK(out == p.now);
+  }
+  SECTION("a prediction from a prior the client does not hold") {
+    const std::vector<std::uint16_t> prior = p.base;
+    protocol::PositionsDelta d;
+    protocol::encode_positions_delta(reference(p.base, 10, &prior), 11, p.now.data(), 310, d);
+    protocol::SnapshotHeader h;
+    h.tick = 11;
+    const protocol::Frame f =
+        protocol::encode_delta_snapshot(h, reference(p.base, 10, &prior), d, 310, nullptr, nullptr, 0);
+    CHECK_THAT(client.positions(snapshot_of(f), out), Catch::Contains("and 9, which this client does not hold"));
   }
   SECTION("an unknown base") {
     const protocol::Frame f = delta_frame(11, 9, p.base, p.now);
@@ -139,16 +185,18 @@ TEST_CASE("a client rebuilds deltas from the bases it kept and refuses those it 
   }
   SECTION("a changes stream cut short, or with bytes after its last ball") {
     protocol::PositionsDelta d;
-    protocol::encode_positions_delta(p.base.data(), 300, p.now.data(), 310, d);
+    protocol::encode_positions_delta(reference(p.base, 10), 11, p.now.data(), 310, d);
     protocol::SnapshotHeader h;
     h.tick = 11;
     protocol::PositionsDelta cut = d;
     cut.changes.resize(d.changes.size() - 1);
-    const protocol::Frame short_frame = protocol::encode_delta_snapshot(h, 10, 300, cut, 310, nullptr, nullptr, 0);
+    const protocol::Frame short_frame =
+        protocol::encode_delta_snapshot(h, reference(p.base, 10), cut, 310, nullptr, nullptr, 0);
     CHECK_THAT(client.positions(snapshot_of(short_frame), out), Catch::Contains("ends inside"));
     protocol::PositionsDelta longer = d;
     longer.changes.push_back(0);
-    const protocol::Frame long_frame = protocol::encode_delta_snapshot(h, 10, 300, longer, 310, nullptr, nullptr, 0);
+    const protocol::Frame long_frame =
+        protocol::encode_delta_snapshot(h, reference(p.base, 10), longer, 310, nullptr, nullptr, 0);
     CHECK_THAT(client.positions(snapshot_of(long_frame), out), Catch::Contains("bytes after"));
   }
   SECTION("a difference that leaves the quantisation range") {
@@ -156,12 +204,12 @@ TEST_CASE("a client rebuilds deltas from the bases it kept and refuses those it 
     protocol::PositionsDelta d;
     std::vector<std::uint16_t> high(3 * 300, 0);
     high[0] = 5;
-    protocol::encode_positions_delta(high.data(), 300, low.data(), 300, d);  // ball 0: x - 5
+    protocol::encode_positions_delta(reference(high), 1, low.data(), 300, d);  // ball 0: x - 5
     protocol::SnapshotHeader h;
-    h.tick = 11;
+    h.tick = 13;
     // Sent against a base (p.base re-kept as all zeros) where x - 5 is below 0.
     REQUIRE(client.positions(snapshot_of(full_frame(12, low)), out).empty());
-    const protocol::Frame f = protocol::encode_delta_snapshot(h, 12, 300, d, 300, nullptr, nullptr, 0);
+    const protocol::Frame f = protocol::encode_delta_snapshot(h, reference(low, 12), d, 300, nullptr, nullptr, 0);
     CHECK_THAT(client.positions(snapshot_of(f), out), Catch::Contains("outside the quantisation range"));
   }
 }
@@ -169,7 +217,7 @@ TEST_CASE("a client rebuilds deltas from the bases it kept and refuses those it 
 TEST_CASE("delta snapshots whose shape is wrong are invalid before anyone reads them", "[protocol][delta]") {
   const Pair p = random_pair(100, 0, 5);
   protocol::PositionsDelta d;
-  protocol::encode_positions_delta(p.base.data(), 100, p.now.data(), 100, d);
+  protocol::encode_positions_delta(reference(p.base), 1, p.now.data(), 100, d);
   protocol::SnapshotHeader h;
   const auto decode = [](const protocol::Frame& f) {
     return protocol::decode_frame(f.data(), f.size(), Direction::to_client);
@@ -178,16 +226,19 @@ TEST_CASE("delta snapshots whose shape is wrong are invalid before anyone reads 
   SECTION("a truncated unchanged mask") {
     protocol::PositionsDelta cut = d;
     cut.unchanged.pop_back();
-    const auto r = decode(protocol::encode_delta_snapshot(h, 0, 100, cut, 100, nullptr, nullptr, 0));
+    const auto r = decode(protocol::encode_delta_snapshot(h, reference(p.base), cut, 100, nullptr, nullptr, 0));
     CHECK(r.status == DecodeStatus::invalid_value);
     CHECK_THAT(r.why, Catch::Contains("unchanged mask"));
   }
   SECTION("more new balls than its changes could hold (a huge ball count; found by fuzzing)") {
-    CHECK(decode(protocol::encode_delta_snapshot(h, 0, 100, d, 4'000'000'000u, nullptr, nullptr, 0)).status ==
-          DecodeStatus::invalid_value);
+    CHECK(
+        decode(protocol::encode_delta_snapshot(h, reference(p.base), d, 4'000'000'000u, nullptr, nullptr, 0)).status ==
+        DecodeStatus::invalid_value);
   }
   SECTION("a mask for a base of another size") {
-    CHECK(decode(protocol::encode_delta_snapshot(h, 0, 200, d, 300, nullptr, nullptr, 0)).status ==
+    protocol::DeltaReference other = reference(p.base);
+    other.base_count = 200;
+    CHECK(decode(protocol::encode_delta_snapshot(h, other, d, 300, nullptr, nullptr, 0)).status ==
           DecodeStatus::invalid_value);
   }
   SECTION("both positions and a mask") {

@@ -153,6 +153,7 @@ TEST_CASE("an Ack the client cannot have meant gets an Error, then a keyframe; t
   CHECK_FALSE(conversation.delta_base());                                    // nothing acknowledged: keyframe
   CHECK(send(protocol::encode_ack(11)).replies.empty());
   CHECK(conversation.delta_base() == 11u);
+  CHECK(conversation.delta_prior() == 10u);               // the one sent before it, to predict moving balls from
   CHECK(send(protocol::encode_ack(10)).replies.empty());  // older than the base: kept at 11
   CHECK(conversation.delta_base() == 11u);
 
