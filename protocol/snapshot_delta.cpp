@@ -21,9 +21,9 @@ class BitWriter {
  public:
   explicit BitWriter(std::vector<std::uint8_t>& out) : out_(out) {}
 
-  // bits <= 32
-  void put(std::uint32_t value, int bits) {
-    acc_ |= std::uint64_t{value} << fill_;
+  // bits <= 56
+  void put(std::uint64_t value, int bits) {
+    acc_ |= value << fill_;
     fill_ += bits;
     for (; fill_ >= 8; fill_ -= 8, acc_ >>= 8) out_.push_back(static_cast<std::uint8_t>(acc_));
   }
@@ -31,8 +31,7 @@ class BitWriter {
   void exp_golomb(std::uint32_t v) {
     const std::uint32_t y = v + 1;
     const int n = floor_log2(y);
-    put(1u << n, n + 1);
-    put(y & ((1u << n) - 1), n);
+    put(std::uint64_t{y & ((1u << n) - 1)} << (n + 1) | 1u << n, 2 * n + 1);  // one write: at most 35 bits
   }
   void flush() {
     if (fill_ > 0) out_.push_back(static_cast<std::uint8_t>(acc_));
