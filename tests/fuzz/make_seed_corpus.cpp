@@ -28,12 +28,18 @@ int main(int argc, char** argv) {
   protocol::SnapshotHeader header;
   header.tick = 5;
   header.sim_time = 1.25;
-  // The next snapshot as a delta against this one: one ball still, one moved, one new.
+  // The next snapshot as a delta against this one: one ball still, one moved, one new;
+  // then one predicted from both (ball 0 falling).
   const std::uint16_t next[12] = {0, 100, 65535, 32769, 1, 0, 2, 3, 4, 7, 8, 9};
-  protocol::PositionsDelta delta;
-  protocol::encode_positions_delta(positions, 3, next, 4, delta);
-  protocol::SnapshotHeader next_header = header;
+  const std::uint16_t third[12] = {0, 100, 65500, 32770, 1, 0, 2, 3, 4, 7, 8, 9};
+  protocol::DeltaReference on_5{positions, 3, 5};
+  protocol::DeltaReference on_6{next, 4, 6, positions, 3, 5};
+  protocol::PositionsDelta delta, predicted;
+  protocol::encode_positions_delta(on_5, 6, next, 4, delta);
+  protocol::encode_positions_delta(on_6, 7, third, 4, predicted);
+  protocol::SnapshotHeader next_header = header, third_header = header;
   next_header.tick = 6;
+  third_header.tick = 7;
 
   const std::vector<std::pair<std::string, protocol::Frame>> frames = {
       {"hello", protocol::encode_hello("seed", true)},
@@ -48,15 +54,16 @@ int main(int argc, char** argv) {
       {"pong", protocol::encode_pong(123456)},
       {"ack", protocol::encode_ack(5)},
       {"ack_keyframe", protocol::encode_ack(7, true)},
-      {"delta_snapshot", protocol::encode_delta_snapshot(next_header, 5, 3, delta, 4, player_ids, players, 1)},
+      {"delta_snapshot", protocol::encode_delta_snapshot(next_header, on_5, delta, 4, player_ids, players, 1)},
+      {"predicted_snapshot", protocol::encode_delta_snapshot(third_header, on_6, predicted, 4, player_ids, players, 1)},
   };
   protocol::Frame conversation{0};  // chunk byte 0: one byte at a time
   for (const char* name : {"hello", "player_input", "add_balls", "ping", "ack", "ack_keyframe"})
     for (const auto& [n, f] : frames)
       if (n == name) conversation.insert(conversation.end(), f.begin(), f.end());
-  // What a client reads: a keyframe, then a delta against it.
+  // What a client reads: a keyframe, a delta against it, a delta predicted from both.
   protocol::Frame snapshots{63};
-  for (const char* name : {"snapshot", "delta_snapshot"})
+  for (const char* name : {"snapshot", "delta_snapshot", "predicted_snapshot"})
     for (const auto& [n, f] : frames)
       if (n == name) snapshots.insert(snapshots.end(), f.begin(), f.end());
 
