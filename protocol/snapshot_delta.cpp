@@ -21,20 +21,28 @@ class BitWriter {
  public:
   explicit BitWriter(std::vector<std::uint8_t>& out) : out_(out) {}
 
-  // bits <= 56
+  // bits <= 32. Whole 32-bit words go out at once: byte by byte was the coder's main cost.
   void put(std::uint64_t value, int bits) {
     acc_ |= value << fill_;
     fill_ += bits;
-    for (; fill_ >= 8; fill_ -= 8, acc_ >>= 8) out_.push_back(static_cast<std::uint8_t>(acc_));
+    if (fill_ < 32) return;
+    const std::uint8_t word[4] = {static_cast<std::uint8_t>(acc_), static_cast<std::uint8_t>(acc_ >> 8),
+                                  static_cast<std::uint8_t>(acc_ >> 16), static_cast<std::uint8_t>(acc_ >> 24)};
+    out_.insert(out_.end(), word, word + 4);
+    acc_ >>= 32;
+    fill_ -= 32;
   }
   // n zeros, a one, then the n bits of v + 1 below its leading one.
   void exp_golomb(std::uint32_t v) {
     const std::uint32_t y = v + 1;
     const int n = floor_log2(y);
-    put(std::uint64_t{y & ((1u << n) - 1)} << (n + 1) | 1u << n, 2 * n + 1);  // one write: at most 35 bits
+    const std::uint64_t low = y & ((1u << n) - 1);
+    if (2 * n + 1 <= 32) return put(low << (n + 1) | 1u << n, 2 * n + 1);
+    put(1u << n, n + 1);
+    put(low, n);
   }
   void flush() {
-    if (fill_ > 0) out_.push_back(static_cast<std::uint8_t>(acc_));
+    for (; fill_ > 0; fill_ -= 8, acc_ >>= 8) out_.push_back(static_cast<std::uint8_t>(acc_));
     acc_ = 0;
     fill_ = 0;
   }
@@ -52,20 +60,17 @@ class BitReader {
   // bits <= 32; false when the stream ends first.
   bool get(int bits, std::uint32_t& value) {
     if (pos_ + static_cast<std::uint64_t>(bits) > bits_) return false;
-    const std::size_t first = pos_ >> 3;
-    const std::size_t last = (pos_ + bits + 7) >> 3;  // one past the last byte touched (at most 5 bytes)
-    std::uint64_t word = 0;
-    for (std::size_t b = first; b < last; ++b) word |= std::uint64_t{data_[b]} << (8 * (b - first));
-    value = static_cast<std::uint32_t>((word >> (pos_ & 7)) & ((std::uint64_t{1} << bits) - 1));
+    value = peek(bits);
     pos_ += static_cast<std::uint64_t>(bits);
     return true;
   }
   bool exp_golomb(std::uint32_t& v) {
-    int n = 0;
-    for (std::uint32_t bit = 0;; ++n) {
-      if (n > kMaxLeadingZeros || !get(1, bit)) return false;
-      if (bit) break;
-    }
+    // The leading zeros counted in one look at the next bits, not one bit at a time.
+    const int ahead = static_cast<int>(std::min<std::uint64_t>(kMaxLeadingZeros + 1, bits_ - pos_));
+    const std::uint32_t window = peek(ahead);
+    if (window == 0) return false;  // more zeros than any code has, or the stream ends among them
+    const int n = __builtin_ctz(window);
+    pos_ += static_cast<std::uint64_t>(n + 1);
     std::uint32_t low = 0;
     if (!get(n, low)) return false;
     v = ((1u << n) | low) - 1;
@@ -79,6 +84,15 @@ class BitReader {
   }
 
  private:
+  // The next `bits` (<= 32, all within the stream) without moving past them.
+  std::uint32_t peek(int bits) const {
+    const std::size_t first = pos_ >> 3;
+    const std::size_t last = (pos_ + bits + 7) >> 3;  // one past the last byte touched (at most 5 bytes)
+    std::uint64_t word = 0;
+    for (std::size_t b = first; b < last; ++b) word |= std::uint64_t{data_[b]} << (8 * (b - first));
+    return static_cast<std::uint32_t>((word >> (pos_ & 7)) & ((std::uint64_t{1} << bits) - 1));
+  }
+
   const std::uint8_t* data_;
   std::uint64_t bits_;
   std::uint64_t pos_ = 0;
