@@ -9,6 +9,9 @@ namespace {
 // A difference of two 16-bit values zigzagged (0, -1, 1, -2, 2 ... -> 0, 1, 2, 3, 4 ...)
 // is below 2^17, so its exp-Golomb code has at most 17 leading zeros.
 constexpr int kMaxLeadingZeros = 17;
+// The stream starts with the exp-Golomb order, in kOrderBits bits.
+constexpr int kOrderBits = 3;
+constexpr int kMaxGolombOrder = (1 << kOrderBits) - 1;
 
 std::uint32_t zigzag(std::int32_t d) {
   return (static_cast<std::uint32_t>(d) << 1) ^ static_cast<std::uint32_t>(d >> 31);
@@ -31,6 +34,11 @@ class BitWriter {
     out_.insert(out_.end(), word, word + 4);
     acc_ >>= 32;
     fill_ -= 32;
+  }
+  // Order k: v >> k as below, then the k low bits of v.
+  void exp_golomb(std::uint32_t v, int k) {
+    exp_golomb(v >> k);
+    put(v & ((1u << k) - 1), k);
   }
   // n zeros, a one, then the n bits of v + 1 below its leading one.
   void exp_golomb(std::uint32_t v) {
@@ -62,6 +70,12 @@ class BitReader {
     if (pos_ + static_cast<std::uint64_t>(bits) > bits_) return false;
     value = peek(bits);
     pos_ += static_cast<std::uint64_t>(bits);
+    return true;
+  }
+  bool exp_golomb(std::uint32_t& v, int k) {
+    std::uint32_t high = 0, low = 0;
+    if (!exp_golomb(high) || !get(k, low)) return false;
+    v = high << k | low;
     return true;
   }
   bool exp_golomb(std::uint32_t& v) {
@@ -125,7 +139,7 @@ void encode_positions_delta(const DeltaReference& ref, std::uint32_t tick, const
   const std::uint32_t common = std::min(ref.base_count, count);
   out.unchanged.assign(unchanged_mask_bytes(ref.base_count, count), 0);
   out.changes.clear();
-  BitWriter changes(out.changes);
+  out.residuals.clear();
   for (std::uint32_t i = 0; i < common; ++i) {
     const std::uint16_t* b = ref.base + 3 * std::size_t{i};
     const std::uint16_t* p = now + 3 * std::size_t{i};
@@ -135,8 +149,16 @@ void encode_positions_delta(const DeltaReference& ref, std::uint32_t tick, const
     }
     std::int32_t expected[3];
     predict(ref, tick, i, expected);
-    for (int axis = 0; axis < 3; ++axis) changes.exp_golomb(zigzag(std::int32_t{p[axis]} - expected[axis]));
+    for (int axis = 0; axis < 3; ++axis) out.residuals.push_back(zigzag(std::int32_t{p[axis]} - expected[axis]));
   }
+  // The order that codes this snapshot's differences in the fewest bits.
+  std::uint64_t bits[kMaxGolombOrder + 1] = {};
+  for (const std::uint32_t z : out.residuals)
+    for (int k = 0; k <= kMaxGolombOrder; ++k) bits[k] += 2 * floor_log2((z >> k) + 1) + k;
+  const int order = static_cast<int>(std::min_element(bits, bits + kMaxGolombOrder + 1) - bits);
+  BitWriter changes(out.changes);
+  changes.put(static_cast<std::uint32_t>(order), kOrderBits);
+  for (const std::uint32_t z : out.residuals) changes.exp_golomb(z, order);
   for (std::size_t v = 3 * std::size_t{common}; v < 3 * std::size_t{count}; ++v) changes.put(now[v], 16);
   changes.flush();
 }
@@ -149,6 +171,8 @@ std::string decode_positions_delta(const DeltaReference& ref, std::uint32_t tick
            std::to_string(unchanged_mask_bytes(ref.base_count, count)) + " expected";
   const std::uint32_t common = std::min(ref.base_count, count);
   BitReader reader(changes, changes_bytes);
+  std::uint32_t order = 0;
+  if (!reader.get(kOrderBits, order)) return "the changes stream is empty";
   for (std::uint32_t i = 0; i < common; ++i) {
     const std::uint16_t* b = ref.base + 3 * std::size_t{i};
     std::uint16_t* p = out + 3 * std::size_t{i};
@@ -160,7 +184,7 @@ std::string decode_positions_delta(const DeltaReference& ref, std::uint32_t tick
     predict(ref, tick, i, expected);
     for (int axis = 0; axis < 3; ++axis) {
       std::uint32_t z = 0;
-      if (!reader.exp_golomb(z)) return "the changes stream ends inside ball " + std::to_string(i);
+      if (!reader.exp_golomb(z, static_cast<int>(order))) return "the changes stream ends inside ball " + std::to_string(i);
       const std::int32_t value = expected[axis] + unzigzag(z);
       if (value < 0 || value > 65535) return "ball " + std::to_string(i) + " moves outside the quantisation range";
       p[axis] = static_cast<std::uint16_t>(value);

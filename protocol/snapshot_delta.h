@@ -7,8 +7,9 @@
 //   balls 0 .. common-1   (common = min(base ball count, ball count))
 //     unchanged  one bit per ball, least significant bit first: 1 = same three
 //                values as in the base, nothing more is sent for it
-//     changes    for each ball whose bit is 0, in id order, three exp-Golomb
-//                codes (order 0) of the zigzagged difference to its prediction, x y z
+//     changes    first the order k (3 bits) of the codes that follow, then for
+//                each ball whose bit is 0, in id order, three exp-Golomb codes of
+//                order k of the zigzagged difference to its prediction, x y z
 //   balls common .. ball count-1   (new since the base)
 //     changes    three raw 16-bit values each, after the differences
 //
@@ -17,9 +18,11 @@
 // when the client holds it) to the base: it is predicted to go on at that
 // velocity. So a settled pile, which sits still or jitters by a quantum, costs
 // 1 bit per ball still and about 5 per ball jittering, and a falling or sliding
-// ball the few bits of its change of velocity instead of its whole move. A ball
-// that moved far from its prediction costs at most 35 bits per axis. The bit
-// stream is least-significant-bit first, padded with zeros to whole bytes.
+// ball the few bits of its change of velocity instead of its whole move. The
+// encoder picks the order k that codes each snapshot in the fewest bits: 0 for a
+// pile that jitters by a quantum, more while balls land and bounce by tens of
+// quanta. The bit stream is least-significant-bit first, padded with zeros to
+// whole bytes.
 
 #include <cstddef>
 #include <cstdint>
@@ -49,6 +52,7 @@ struct DeltaReference {
 struct PositionsDelta {
   std::vector<std::uint8_t> unchanged;
   std::vector<std::uint8_t> changes;
+  std::vector<std::uint32_t> residuals;  // the encoder's scratch, kept to reuse its memory
 };
 
 // now holds 3 * count values of snapshot `tick` (above ref.base_tick). out is overwritten.
