@@ -38,7 +38,7 @@ class BitWriter {
   // Order k: v >> k as below, then the k low bits of v.
   void exp_golomb(std::uint32_t v, int k) {
     exp_golomb(v >> k);
-    put(v & ((1u << k) - 1), k);
+    if (k > 0) put(v & ((1u << k) - 1), k);
   }
   // n zeros, a one, then the n bits of v + 1 below its leading one.
   void exp_golomb(std::uint32_t v) {
@@ -74,7 +74,7 @@ class BitReader {
   }
   bool exp_golomb(std::uint32_t& v, int k) {
     std::uint32_t high = 0, low = 0;
-    if (!exp_golomb(high) || !get(k, low)) return false;
+    if (!exp_golomb(high) || (k > 0 && !get(k, low))) return false;
     v = high << k | low;
     return true;
   }
@@ -151,11 +151,22 @@ void encode_positions_delta(const DeltaReference& ref, std::uint32_t tick, const
     predict(ref, tick, i, expected);
     for (int axis = 0; axis < 3; ++axis) out.residuals.push_back(zigzag(std::int32_t{p[axis]} - expected[axis]));
   }
-  // The order that codes this snapshot's differences in the fewest bits.
-  std::uint64_t bits[kMaxGolombOrder + 1] = {};
-  for (const std::uint32_t z : out.residuals)
-    for (int k = 0; k <= kMaxGolombOrder; ++k) bits[k] += 2 * floor_log2((z >> k) + 1) + k;
-  const int order = static_cast<int>(std::min_element(bits, bits + kMaxGolombOrder + 1) - bits);
+  // The order that codes this snapshot's differences in about the fewest bits, from
+  // a histogram of their lengths: a code of order k for a value of L significant
+  // bits takes about 2 max(L - k, 0) + 1 + k bits.
+  std::uint64_t lengths[kMaxLeadingZeros + 1] = {};
+  for (const std::uint32_t z : out.residuals) ++lengths[floor_log2(z + 1)];
+  std::uint64_t best_bits = UINT64_MAX;
+  int order = 0;
+  for (int k = 0; k <= kMaxGolombOrder; ++k) {
+    std::uint64_t bits = 0;
+    for (int length = 0; length <= kMaxLeadingZeros; ++length)
+      bits += lengths[length] * static_cast<std::uint64_t>(2 * std::max(length - k, 0) + 1 + k);
+    if (bits < best_bits) {
+      best_bits = bits;
+      order = k;
+    }
+  }
   BitWriter changes(out.changes);
   changes.put(static_cast<std::uint32_t>(order), kOrderBits);
   for (const std::uint32_t z : out.residuals) changes.exp_golomb(z, order);
@@ -184,7 +195,8 @@ std::string decode_positions_delta(const DeltaReference& ref, std::uint32_t tick
     predict(ref, tick, i, expected);
     for (int axis = 0; axis < 3; ++axis) {
       std::uint32_t z = 0;
-      if (!reader.exp_golomb(z, static_cast<int>(order))) return "the changes stream ends inside ball " + std::to_string(i);
+      if (!reader.exp_golomb(z, static_cast<int>(order)))
+        return "the changes stream ends inside ball " + std::to_string(i);
       const std::int32_t value = expected[axis] + unzigzag(z);
       if (value < 0 || value > 65535) return "ball " + std::to_string(i) + " moves outside the quantisation range";
       p[axis] = static_cast<std::uint16_t>(value);

@@ -116,7 +116,7 @@ TEST_CASE("balls at rest cost one bit; a quantum of jitter a few more", "[protoc
   protocol::PositionsDelta d;
   protocol::encode_positions_delta(reference(base), 1, now.data(), 8000, d);
   CHECK(d.unchanged.size() == 1000);
-  CHECK(d.changes.size() == 1);  // the order of the codes, and no code
+  CHECK(d.changes.size() == 1);                                // the order of the codes, and no code
   for (std::size_t b = 0; b < 8000; b += 4) ++now[3 * b + 1];  // a quarter of the balls up one quantum
   protocol::encode_positions_delta(reference(base), 1, now.data(), 8000, d);
   CHECK(d.changes.size() == (3 + 2000 * 5 + 7) / 8);  // the order (0), then 1 + 3 + 1 bits each
