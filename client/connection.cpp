@@ -101,58 +101,9 @@ void Connection::handle(const wire::Message& message) {
       view_.kinds.insert(view_.kinds.end(), k.kinds()->begin(), k.kinds()->end());
       break;
     }
-    case wire::Payload::Snapshot: {
-      const wire::Snapshot& s = *message.payload_as_Snapshot();
-      if (stats_.snapshots > 0 && s.tick() > view_.tick + 1) stats_.skipped_snapshots += s.tick() - view_.tick - 1;
-      if (s.ball_count() > view_.kinds.size())
-        stats_.errors.push_back("Snapshot has " + std::to_string(s.ball_count()) + " balls but kinds of only " +
-                                std::to_string(view_.kinds.size()) + " were sent");
-      view_.tick = s.tick();
-      view_.sim_time = s.sim_time();
-      view_.steps_per_s = s.steps_per_s();
-      view_.load = s.load();
-      view_.threads_stepping = s.threads_stepping();
-      view_.time_scale = s.time_scale();
-      view_.ball_count = s.ball_count();
-      view_.physics_steps = s.physics_steps();
-      view_.paused = s.paused();
-      view_.time_scale_set = s.time_scale_set();
-      view_.scene = s.scene() ? s.scene()->str() : std::string();
-      if (s.scene_start() != view_.scene_start) view_.positions.clear();  // other balls: nothing to compare
-      view_.scene_start = s.scene_start();
-      view_.kinetic_energy_per_ball = s.kinetic_energy_per_ball();
-      view_.contacts = s.contacts();
-      if (s.tank_min()) {  // decode_frame checked that both are present and ordered
-        tank_.min = {s.tank_min()->x(), s.tank_min()->y(), s.tank_min()->z()};
-        tank_.max = {s.tank_max()->x(), s.tank_max()->y(), s.tank_max()->z()};
-      }
-      const std::size_t common = std::min<std::size_t>(view_.positions.size(), s.positions()->size()) / 3;
-      std::size_t at_rest = 0, small = 0;
-      for (std::size_t b = 0; b < common; ++b) {
-        int largest = 0;
-        for (std::size_t axis = 0; axis < 3; ++axis)
-          largest =
-              std::max(largest, std::abs(int{s.positions()->Get(3 * b + axis)} - int{view_.positions[3 * b + axis]}));
-        at_rest += largest == 0;
-        small += largest <= 127;
-      }
-      stats_.at_rest_fraction = common ? static_cast<double>(at_rest) / common : 0.0;
-      stats_.int8_delta_fraction = common ? static_cast<double>(small) / common : 0.0;
-      view_.positions.assign(s.positions()->begin(), s.positions()->end());
-      view_.player_ids.clear();
-      view_.player_positions.clear();
-      if (s.player_ids())
-        for (std::uint32_t i = 0; i < s.player_ids()->size(); ++i) {
-          const wire::Vec3f* p = s.player_positions()->Get(i);
-          view_.player_ids.push_back(s.player_ids()->Get(i));
-          view_.player_positions.push_back({p->x(), p->y(), p->z()});
-        }
-      const auto now = std::chrono::steady_clock::now();
-      if (!stats_.first_snapshot) stats_.first_snapshot = now;
-      stats_.last_snapshot = now;
-      ++stats_.snapshots;
+    case wire::Payload::Snapshot:
+      on_snapshot(*message.payload_as_Snapshot());
       break;
-    }
     case wire::Payload::Error: {
       const wire::Error& e = *message.payload_as_Error();
       // A code newer than this client has no name here: its number instead.
@@ -170,6 +121,63 @@ void Connection::handle(const wire::Message& message) {
     default:  // decode_frame accepts only server messages in this direction
       break;
   }
+}
+
+void Connection::on_snapshot(const wire::Snapshot& s) {
+  if (std::string why = received_.positions(s, decoded_); !why.empty()) {
+    stats_.errors.push_back(why);
+    if (acknowledge_) send(protocol::encode_ack(s.tick(), /*want_keyframe=*/true));
+    return;
+  }
+  if (acknowledge_) send(protocol::encode_ack(s.tick()));
+  if (stats_.snapshots > 0 && s.tick() > view_.tick + 1) stats_.skipped_snapshots += s.tick() - view_.tick - 1;
+  if (s.ball_count() > view_.kinds.size())
+    stats_.errors.push_back("Snapshot has " + std::to_string(s.ball_count()) + " balls but kinds of only " +
+                            std::to_string(view_.kinds.size()) + " were sent");
+  stats_.keyframes += s.unchanged() == nullptr;
+  view_.tick = s.tick();
+  view_.sim_time = s.sim_time();
+  view_.steps_per_s = s.steps_per_s();
+  view_.load = s.load();
+  view_.threads_stepping = s.threads_stepping();
+  view_.time_scale = s.time_scale();
+  view_.ball_count = s.ball_count();
+  view_.physics_steps = s.physics_steps();
+  view_.paused = s.paused();
+  view_.time_scale_set = s.time_scale_set();
+  view_.scene = s.scene() ? s.scene()->str() : std::string();
+  if (s.scene_start() != view_.scene_start) view_.positions.clear();  // other balls: nothing to compare
+  view_.scene_start = s.scene_start();
+  view_.kinetic_energy_per_ball = s.kinetic_energy_per_ball();
+  view_.contacts = s.contacts();
+  if (s.tank_min()) {  // decode_frame checked that both are present and ordered
+    tank_.min = {s.tank_min()->x(), s.tank_min()->y(), s.tank_min()->z()};
+    tank_.max = {s.tank_max()->x(), s.tank_max()->y(), s.tank_max()->z()};
+  }
+  const std::size_t common = std::min(view_.positions.size(), decoded_.size()) / 3;
+  std::size_t at_rest = 0, small = 0;
+  for (std::size_t b = 0; b < common; ++b) {
+    int largest = 0;
+    for (std::size_t axis = 0; axis < 3; ++axis)
+      largest = std::max(largest, std::abs(int{decoded_[3 * b + axis]} - int{view_.positions[3 * b + axis]}));
+    at_rest += largest == 0;
+    small += largest <= 127;
+  }
+  stats_.at_rest_fraction = common ? static_cast<double>(at_rest) / common : 0.0;
+  stats_.int8_delta_fraction = common ? static_cast<double>(small) / common : 0.0;
+  view_.positions.swap(decoded_);
+  view_.player_ids.clear();
+  view_.player_positions.clear();
+  if (s.player_ids())
+    for (std::uint32_t i = 0; i < s.player_ids()->size(); ++i) {
+      const wire::Vec3f* p = s.player_positions()->Get(i);
+      view_.player_ids.push_back(s.player_ids()->Get(i));
+      view_.player_positions.push_back({p->x(), p->y(), p->z()});
+    }
+  const auto now = std::chrono::steady_clock::now();
+  if (!stats_.first_snapshot) stats_.first_snapshot = now;
+  stats_.last_snapshot = now;
+  ++stats_.snapshots;
 }
 
 std::optional<Vec3> Connection::player_position(std::uint32_t player_id) const {

@@ -2,6 +2,7 @@
 // One client connection to a fishtank-server, on a caller-owned io_context
 // (several connections can share one thread). It says Hello, keeps the newest
 // snapshot's state and counts what it receives; writes are queued, one in flight.
+// It acknowledges every snapshot it decodes, so the server sends deltas.
 // Used by fishtank-client and by the network tests.
 
 #include <boost/asio.hpp>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "protocol/frame_codec.h"
+#include "protocol/received_snapshots.h"
 
 namespace fishtank::client {
 
@@ -21,6 +23,7 @@ struct ConnectionStats {
   std::uint64_t snapshots = 0;
   std::uint64_t bytes_received = 0;
   std::uint64_t skipped_snapshots = 0;   // gaps in Snapshot.tick
+  std::uint64_t keyframes = 0;           // snapshots sent in full; the others were deltas
   std::vector<double> rtt_ms;            // one per Pong
   std::vector<std::string> errors;       // Error messages, "code: message"
   std::vector<std::string> error_codes;  // the code of each Error, e.g. "too_slow"
@@ -63,6 +66,8 @@ class Connection : public std::enable_shared_from_this<Connection> {
   void start(const boost::asio::ip::tcp::endpoint& server, std::uint32_t version = protocol::kProtocolVersion);
   void send(protocol::Frame frame);
   void send_ping();
+  // Off: no Ack is sent, so every snapshot comes in full (as before deltas).
+  void acknowledge_snapshots(bool on) { acknowledge_ = on; }
   void close();
 
   bool welcomed() const { return welcomed_; }
@@ -83,6 +88,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
  private:
   void do_read();
   void handle(const wire::Message& message);
+  void on_snapshot(const wire::Snapshot& s);
   void do_write();
   void fail(const std::string& reason);
 
@@ -93,6 +99,9 @@ class Connection : public std::enable_shared_from_this<Connection> {
   std::vector<std::uint8_t> read_buffer_ = std::vector<std::uint8_t>(64 * 1024);
   std::deque<protocol::Frame> outgoing_;
   bool write_in_flight_ = false;
+  bool acknowledge_ = true;
+  protocol::ReceivedSnapshots received_;
+  std::vector<std::uint16_t> decoded_;  // scratch: the positions of the snapshot being read
 
   bool welcomed_ = false;
   bool closed_ = false;

@@ -13,18 +13,40 @@ int main(int argc, char** argv) {
     return parsed.exit_code;
   }
   const fishtank::client::ClientOptions& o = *parsed.options;
-  const fishtank::client::Summary s = fishtank::client::run_script(o.script);
+  // Per ball per snapshot: what a snapshot costs, whatever the rate and the tank.
+  const auto per_ball = [](double bytes, double snapshots, double balls) {
+    return snapshots > 0.0 && balls > 0.0 ? bytes / (snapshots * balls) : 0.0;
+  };
+  const fishtank::client::Summary s =
+      fishtank::client::run_script(o.script, [&](const fishtank::client::IntervalReport& r) {
+        const double bytes_per_ball = per_ball(r.bytes, r.snapshots, r.balls);
+        if (o.json)
+          std::cout << nlohmann::json{{"t", r.t},
+                                      {"balls", r.balls},
+                                      {"snapshots", r.snapshots},
+                                      {"keyframes", r.keyframes},
+                                      {"bytes", r.bytes},
+                                      {"bytes_per_ball", bytes_per_ball}}
+                           .dump()
+                    << std::endl;
+        else
+          std::cout << "t " << r.t << " s: " << r.snapshots << " snapshots (" << r.keyframes << " in full), " << r.bytes
+                    << " bytes, " << bytes_per_ball << " bytes per ball per snapshot\n";
+      });
   if (!s.connect_error.empty()) {
     std::cerr << "fishtank-client: no connection to " << o.script.host << ":" << o.script.port << ": "
               << s.connect_error << "\n";
     return 1;
   }
+  const double bytes_per_ball = per_ball(s.bytes_per_s, s.snapshot_rate_hz, s.balls);
   if (o.json) {
     nlohmann::json j = {{"clients", s.clients},
                         {"welcomed", s.welcomed},
                         {"snapshots", s.snapshots},
+                        {"keyframes", s.keyframes},
                         {"snapshot_rate_hz", s.snapshot_rate_hz},
                         {"bytes_per_s", s.bytes_per_s},
+                        {"bytes_per_ball", bytes_per_ball},
                         {"rtt_ms", s.rtt_ms},
                         {"balls", s.balls},
                         {"steps_per_s", s.steps_per_s},

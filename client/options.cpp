@@ -45,17 +45,22 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   std::string scene;
   float time_scale = 0.0f;
   bool reset = false, pause = false, resume = false;
+  bool no_ack = false;
 
   po::options_description flags("Options");
   flags.add_options()("help,h", "print this help and exit")("connect", po::value(&connect)->default_value(connect),
                                                             "server address, host:port")(
       "clients", po::value(&clients)->default_value(clients), "concurrent connections, 1 .. 1000")(
       "observer", po::bool_switch(&o.script.observer), "ask for no player sphere")(
+      "no-ack", po::bool_switch(&no_ack),
+      "never acknowledge snapshots, so that the server sends each in full instead of a delta")(
       "add", po::value(&add)->default_value(0), "balls the first client asks the server to pour in")(
       "move", po::value(&move), "player sphere velocity x,y,z in m/s (every client with a sphere)")(
       "for", po::value(&o.script.move_for)->default_value(o.script.move_for), "seconds to move before stopping")(
       "duration", po::value(&o.script.duration)->default_value(o.script.duration), "seconds to stay connected")(
-      "json", po::bool_switch(&o.json), "print one JSON summary on stdout");
+      "every", po::value(&o.script.every)->default_value(0.0),
+      "also report what was received every this many seconds (0: only the summary)")(
+      "json", po::bool_switch(&o.json), "print one JSON summary on stdout (and one JSON line per --every interval)");
   po::options_description controls(
       "Sandbox controls (sent once by the first client; the server's --control says who may)");
   controls.add_options()("scene", po::value(&scene), "start this scene: tank, wide, dam-break or drop")(
@@ -83,8 +88,8 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   if (vm.count("help")) {
     std::ostringstream help;
     help << "fishtank-client: connects to a fishtank-server, runs a short script and reports what it received.\n\n"
-         << "Usage: fishtank-client [--connect host:port] [--clients K] [--observer] [--add N]\n"
-         << "                       [--move x,y,z --for T] [--duration T] [--json]\n"
+         << "Usage: fishtank-client [--connect host:port] [--clients K] [--observer] [--no-ack] [--add N]\n"
+         << "                       [--move x,y,z --for T] [--duration T] [--every T] [--json]\n"
          << "                       [--scene NAME | --reset] [--seed S] [--time-scale X] [--pause | --resume] [--step "
             "N]\n\n"
          << "Example: fishtank-client --clients 8 --add 1000 --move 2,0,0 --for 1 --duration 5 --json\n"
@@ -106,6 +111,7 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   if (!std::isfinite(o.script.move_for) || o.script.move_for < 0.0) return fail("--for must be seconds >= 0");
   if (!std::isfinite(o.script.duration) || o.script.duration <= 0.0 || o.script.duration > 86400.0)
     return fail("--duration must be between 0 and 86400 seconds");
+  if (!std::isfinite(o.script.every) || o.script.every < 0.0) return fail("--every must be seconds >= 0");
   if (pause && resume) return fail("--pause and --resume contradict each other; give one");
   if (step < 0 || step > protocol::kMaxStepsPerRequest)
     return fail("--step must be between 0 and " + std::to_string(protocol::kMaxStepsPerRequest));
@@ -122,6 +128,7 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   o.script.reset = reset;
   o.script.step = static_cast<std::uint32_t>(step);
   o.script.clients = static_cast<int>(clients);
+  o.script.acknowledge = !no_ack;
   o.script.add = static_cast<std::uint32_t>(add);
   result.options = o;
   return result;

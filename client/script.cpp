@@ -30,6 +30,7 @@ Summary summarise(const std::vector<std::shared_ptr<Connection>>& connections, d
     const ConnectionStats& st = c->stats();
     s.welcomed += c->welcomed();
     s.snapshots += st.snapshots;
+    s.keyframes += st.keyframes;
     s.bytes_per_s += st.bytes_received / seconds;
     if (st.snapshots >= 2)
       s.snapshot_rate_hz +=
@@ -80,7 +81,7 @@ std::vector<protocol::Frame> control_frames(const Script& script) {
 
 }  // namespace
 
-Summary run_script(const Script& script) {
+Summary run_script(const Script& script, const std::function<void(const IntervalReport&)>& on_interval) {
   asio::io_context io;
   boost::system::error_code ec;
   asio::ip::tcp::resolver resolver(io);
@@ -96,6 +97,7 @@ Summary run_script(const Script& script) {
   for (int i = 0; i < script.clients; ++i) {
     connections.push_back(
         std::make_shared<Connection>(io, "fishtank-client-" + std::to_string(i + 1), !script.observer));
+    connections.back()->acknowledge_snapshots(script.acknowledge);
     connections.back()->start(server);
   }
 
@@ -106,12 +108,27 @@ Summary run_script(const Script& script) {
   int tick = 0;
   asio::steady_timer timer(io);
   std::vector<double> dropped_at(connections.size(), -1.0);  // seconds; -1 while open
+  IntervalReport reported;                                   // the totals at the last report
+  const auto report_interval = [&](double t) {
+    IntervalReport now;
+    now.t = t;
+    for (const auto& c : connections) {
+      now.snapshots += c->stats().snapshots;
+      now.keyframes += c->stats().keyframes;
+      now.bytes += c->stats().bytes_received;
+      now.balls = std::max(now.balls, c->view().ball_count);
+    }
+    on_interval({now.t, now.balls, now.snapshots - reported.snapshots, now.keyframes - reported.keyframes,
+                 now.bytes - reported.bytes});
+    reported = now;
+  };
   std::function<void()> on_tick = [&] {
     const double t = seconds_since(start);
     if (t >= script.duration) {
       for (auto& c : connections) c->close();
       return;
     }
+    if (script.every > 0.0 && on_interval && t >= reported.t + script.every) report_interval(t);
     for (std::size_t i = 0; i < connections.size(); ++i)
       if (dropped_at[i] < 0.0 && connections[i]->closed()) dropped_at[i] = t;
     if (std::all_of(dropped_at.begin(), dropped_at.end(), [](double d) { return d >= 0.0; })) return;  // all gone

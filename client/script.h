@@ -6,6 +6,7 @@
 // --duration seconds everything is summed up.
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,6 +20,7 @@ struct Script {
   std::uint16_t port = 7878;
   int clients = 1;
   bool observer = false;
+  bool acknowledge = true;  // false (--no-ack): every snapshot comes in full
   std::uint32_t add = 0;
   std::optional<Vec3> move;
   double move_for = 1.0;  // seconds
@@ -30,12 +32,21 @@ struct Script {
   std::optional<float> time_scale;
   std::optional<bool> pause;  // true: Pause, false: resume
   std::uint32_t step = 0;     // steps to run while paused
+  double every = 0.0;         // seconds between interval reports; 0: none
+};
+
+// What every connection received in one --every interval, summed.
+struct IntervalReport {
+  double t = 0.0;           // seconds since the start, at the end of the interval
+  std::uint32_t balls = 0;  // in the newest snapshot
+  std::uint64_t snapshots = 0, keyframes = 0, bytes = 0;
 };
 
 struct Summary {
   int clients = 0;
   int welcomed = 0;
   std::uint64_t snapshots = 0;    // total over all clients
+  std::uint64_t keyframes = 0;    // of those, the ones sent in full (the rest were deltas)
   double snapshot_rate_hz = 0.0;  // mean per client
   double bytes_per_s = 0.0;       // mean per client
   double rtt_ms = 0.0;            // median over every Pong; 0 without any
@@ -61,6 +72,7 @@ struct Summary {
   int dropped = 0;
 };
 
-Summary run_script(const Script& script);
+// on_interval is called every script.every seconds (when that is > 0).
+Summary run_script(const Script& script, const std::function<void(const IntervalReport&)>& on_interval = {});
 
 }  // namespace fishtank::client

@@ -1,5 +1,6 @@
 #include "protocol/frame_codec.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -45,6 +46,7 @@ bool accepted_by(wire::Payload type, Direction to) {
     case wire::Payload::Step:
     case wire::Payload::Reset:
     case wire::Payload::SetTimeScale:
+    case wire::Payload::Ack:
       return to == Direction::to_server;
     case wire::Payload::Welcome:
     case wire::Payload::BallKinds:
@@ -55,6 +57,30 @@ bool accepted_by(wire::Payload type, Direction to) {
     default:
       return false;
   }
+}
+
+// A full snapshot has 3 positions per ball; a delta has no positions, and an
+// unchanged mask of one bit per ball it shares with its base.
+std::string check_positions(const wire::Snapshot& s) {
+  if (s.unchanged()) {
+    if (s.positions() || !s.changes()) return "delta Snapshot has positions, or lacks its changes";
+    const std::size_t expected = unchanged_mask_bytes(s.base_ball_count(), s.ball_count());
+    if (s.unchanged()->size() != expected)
+      return "delta Snapshot has an unchanged mask of " + std::to_string(s.unchanged()->size()) + " bytes for " +
+             std::to_string(expected) + " bytes of balls (truncated or overlong)";
+    // Checked here, before a reader allocates ball_count positions (found by fuzzing).
+    const std::uint64_t new_balls = s.ball_count() - std::min(s.base_ball_count(), s.ball_count());
+    if (new_balls * 6 > s.changes()->size())
+      return "delta Snapshot has " + std::to_string(new_balls) + " new balls but only " +
+             std::to_string(s.changes()->size()) + " bytes of changes (6 per new ball at least)";
+    return {};
+  }
+  if (!s.positions()) return "Snapshot lacks its positions vector";
+  const std::uint64_t values = s.positions()->size();
+  if (values != 3 * std::uint64_t{s.ball_count()})
+    return "Snapshot has " + std::to_string(values) + " position values for " + std::to_string(s.ball_count()) +
+           " balls (3 per ball expected)";
+  return {};
 }
 
 // Values the Verifier cannot judge. Empty when the message is usable.
@@ -80,6 +106,7 @@ std::string check_values(const wire::Message& m) {
     case wire::Payload::Ping:
     case wire::Payload::Pong:
     case wire::Payload::Pause:
+    case wire::Payload::Ack:  // any tick: only the session knows which it sent
       return {};
     case wire::Payload::Step: {
       const std::uint32_t count = m.payload_as_Step()->count();
@@ -125,12 +152,8 @@ std::string check_values(const wire::Message& m) {
     }
     case wire::Payload::Snapshot: {
       const wire::Snapshot& s = *m.payload_as_Snapshot();
-      if (!s.positions() || !s.player_ids() || !s.player_positions())
-        return "Snapshot lacks its positions, player_ids or player_positions vector";
-      const std::uint64_t values = s.positions()->size();
-      if (values != 3 * std::uint64_t{s.ball_count()})
-        return "Snapshot has " + std::to_string(values) + " position values for " + std::to_string(s.ball_count()) +
-               " balls (3 per ball expected)";
+      if (!s.player_ids() || !s.player_positions()) return "Snapshot lacks its player_ids or player_positions vector";
+      if (std::string why = check_positions(s); !why.empty()) return why;
       if (s.player_ids()->size() != s.player_positions()->size())
         return "Snapshot player_ids and player_positions differ in length";
       for (const wire::Vec3f* p : *s.player_positions())
@@ -201,6 +224,11 @@ Frame encode_set_time_scale(float scale) {
   return finish(b, wire::CreateSetTimeScale(b, scale));
 }
 
+Frame encode_ack(std::uint32_t tick, bool want_keyframe) {
+  flatbuffers::FlatBufferBuilder b(64);
+  return finish(b, wire::CreateAck(b, tick, want_keyframe));
+}
+
 Frame encode_welcome(const WelcomeInfo& info) {
   flatbuffers::FlatBufferBuilder b(512);
   const auto variant = b.CreateString(info.server_variant);
@@ -221,11 +249,15 @@ Frame encode_ball_kinds(std::uint32_t first_new_ball, const std::uint8_t* kinds,
   return finish(b, wire::CreateBallKinds(b, first_new_ball, kinds_offset));
 }
 
-Frame encode_snapshot(const SnapshotHeader& header, const std::uint16_t* quantised, std::uint32_t ball_count,
-                      const std::uint32_t* player_ids, const Vec3* player_positions, std::size_t players) {
-  const std::size_t values = 3 * std::size_t{ball_count};
-  flatbuffers::FlatBufferBuilder b(256 + 2 * values + 16 * players);
-  const auto positions = b.CreateVector(quantised, values);
+namespace {
+
+// Positions are added by the caller: the full vector, or a delta's fields.
+template <class AddPositions>
+Frame encode_snapshot_with(const SnapshotHeader& header, std::uint32_t ball_count, const std::uint32_t* player_ids,
+                           const Vec3* player_positions, std::size_t players, std::size_t position_bytes,
+                           AddPositions add_positions) {
+  flatbuffers::FlatBufferBuilder b(256 + position_bytes + 16 * players);
+  const auto positions = add_positions(b);
   const auto ids = b.CreateVector(player_ids, players);
   // Not CreateUninitializedVectorOfStructs: in FlatBuffers 2.0.8 it aligns a
   // 12-byte struct to 12 bytes, which corrupts the buffer.
@@ -234,11 +266,62 @@ Frame encode_snapshot(const SnapshotHeader& header, const std::uint16_t* quantis
   const auto player_offset = b.CreateVectorOfStructs(player_wire);
   const auto scene = b.CreateString(header.scene);
   const wire::Vec3f tank_min = to_wire(header.tank.min), tank_max = to_wire(header.tank.max);
-  return finish(
-      b, wire::CreateSnapshot(b, header.tick, header.sim_time, header.physics_steps, header.steps_per_s, header.load,
-                              ball_count, positions, ids, player_offset, header.threads_stepping, header.time_scale,
-                              header.paused, header.time_scale_set, scene, header.scene_start, &tank_min, &tank_max,
-                              header.kinetic_energy_per_ball, header.contacts));
+  wire::SnapshotBuilder s(b);
+  s.add_tick(header.tick);
+  s.add_sim_time(header.sim_time);
+  s.add_physics_steps(header.physics_steps);
+  s.add_steps_per_s(header.steps_per_s);
+  s.add_load(header.load);
+  s.add_ball_count(ball_count);
+  s.add_player_ids(ids);
+  s.add_player_positions(player_offset);
+  s.add_threads_stepping(header.threads_stepping);
+  s.add_time_scale(header.time_scale);
+  s.add_paused(header.paused);
+  s.add_time_scale_set(header.time_scale_set);
+  s.add_scene(scene);
+  s.add_scene_start(header.scene_start);
+  s.add_tank_min(&tank_min);
+  s.add_tank_max(&tank_max);
+  s.add_kinetic_energy_per_ball(header.kinetic_energy_per_ball);
+  s.add_contacts(header.contacts);
+  positions.add_to(s);
+  return finish(b, s.Finish());
+}
+
+}  // namespace
+
+Frame encode_snapshot(const SnapshotHeader& header, const std::uint16_t* quantised, std::uint32_t ball_count,
+                      const std::uint32_t* player_ids, const Vec3* player_positions, std::size_t players) {
+  struct Full {
+    flatbuffers::Offset<flatbuffers::Vector<std::uint16_t>> positions;
+    void add_to(wire::SnapshotBuilder& s) const { s.add_positions(positions); }
+  };
+  const std::size_t values = 3 * std::size_t{ball_count};
+  return encode_snapshot_with(
+      header, ball_count, player_ids, player_positions, players, 2 * values,
+      [&](flatbuffers::FlatBufferBuilder& b) { return Full{b.CreateVector(quantised, values)}; });
+}
+
+Frame encode_delta_snapshot(const SnapshotHeader& header, const DeltaReference& ref, const PositionsDelta& delta,
+                            std::uint32_t ball_count, const std::uint32_t* player_ids, const Vec3* player_positions,
+                            std::size_t players) {
+  struct Delta {
+    const DeltaReference& ref;
+    flatbuffers::Offset<flatbuffers::Vector<std::uint8_t>> unchanged, changes;
+    void add_to(wire::SnapshotBuilder& s) const {
+      s.add_base_tick(ref.base_tick);
+      s.add_base_ball_count(ref.base_count);
+      s.add_unchanged(unchanged);
+      s.add_changes(changes);
+      s.add_prior_tick(ref.prior_tick);
+      s.add_predicted(ref.prior != nullptr);
+    }
+  };
+  return encode_snapshot_with(header, ball_count, player_ids, player_positions, players,
+                              delta.unchanged.size() + delta.changes.size(), [&](flatbuffers::FlatBufferBuilder& b) {
+                                return Delta{ref, b.CreateVector(delta.unchanged), b.CreateVector(delta.changes)};
+                              });
 }
 
 Frame encode_error(wire::ErrorCode code, std::string_view message) {

@@ -14,7 +14,8 @@
 //      payload type that the receiving side accepts.
 // When decoding is ok, the payload table and every field a reader needs are
 // present (the Verifier alone allows them to be absent): Hello.client_name may
-// be null; everything else in fishtank.fbs may be dereferenced.
+// be null; a Snapshot has either positions or (a delta) unchanged and changes;
+// everything else in fishtank.fbs may be dereferenced.
 // A bad length or a failed verification breaks the stream (stream_broken()): the
 // reader cannot tell where the next frame starts, so it should disconnect.
 
@@ -29,6 +30,7 @@
 #include "common/tank.h"
 #include "common/vec3.h"
 #include "protocol/fishtank_generated.h"
+#include "protocol/snapshot_delta.h"
 
 namespace fishtank::protocol {
 
@@ -63,6 +65,7 @@ Frame encode_step(std::uint32_t count);
 // An empty scene restarts the scene running; no seed keeps the scene's last seed.
 Frame encode_reset(std::string_view scene, std::optional<std::uint64_t> seed);
 Frame encode_set_time_scale(float scale);
+Frame encode_ack(std::uint32_t tick, bool want_keyframe = false);
 
 // ---- encoding: server -> client ----
 struct WelcomeInfo {
@@ -102,6 +105,10 @@ struct SnapshotHeader {
 // player_ids and player_positions hold `players` entries each.
 Frame encode_snapshot(const SnapshotHeader& header, const std::uint16_t* quantised, std::uint32_t ball_count,
                       const std::uint32_t* player_ids, const Vec3* player_positions, std::size_t players);
+// The same snapshot with its positions coded against `ref` (protocol/snapshot_delta.h).
+Frame encode_delta_snapshot(const SnapshotHeader& header, const DeltaReference& ref, const PositionsDelta& delta,
+                            std::uint32_t ball_count, const std::uint32_t* player_ids, const Vec3* player_positions,
+                            std::size_t players);
 
 Frame encode_error(wire::ErrorCode code, std::string_view message);
 Frame encode_pong(std::uint32_t client_time_us);

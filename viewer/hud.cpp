@@ -108,7 +108,12 @@ void Hud::stats(const HudView& v) {
     row(live, "Server", "%s", net.endpoint.c_str());
   }
   row(live, "Snapshots", "%.1f /s   render delay %.0f ms", net.snapshots_per_s, v.render_delay_ms);
-  row(live, "Bandwidth", "%.1f KiB/s in", net.bytes_per_s / 1024.0f);
+  // Bytes received, frames whole: with deltas a still pile costs a fraction of a byte per ball.
+  if (s && s->ball_count > 0 && net.snapshots_per_s > 0.0f)
+    row(live, "Bandwidth", "%.1f KiB/s in, %.2f B per ball", net.bytes_per_s / 1024.0f,
+        net.bytes_per_s / (net.snapshots_per_s * static_cast<float>(s->ball_count)));
+  else
+    row(live, "Bandwidth", "%.1f KiB/s in", net.bytes_per_s / 1024.0f);
   if (net.rtt_ms >= 0.0f)
     row(live, "Round trip", "%.2f ms", net.rtt_ms);
   else

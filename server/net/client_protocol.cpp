@@ -21,6 +21,7 @@ ClientProtocol::ClientProtocol(std::uint32_t client_id, const ServerInfo& info)
     : client_id_(client_id),
       info_(info),
       commands_(info.limits.max_commands_per_s, info.limits.max_commands_per_s),
+      ack_budget_(2.0 * info.snapshot_rate_hz, 2.0 * info.snapshot_rate_hz),
       balls_(info.limits.add_balls_per_minute / 60.0, info.limits.add_balls_per_minute) {}
 
 Outcome ClientProtocol::refuse(wire::ErrorCode code, const std::string& why, bool disconnect) {
@@ -48,10 +49,14 @@ protocol::DecodeResult ClientProtocol::check_length_prefix(const std::uint8_t* p
 Outcome ClientProtocol::on_frame(const std::uint8_t* frame, std::size_t size, Clock::time_point now) {
   const protocol::DecodeResult decoded = protocol::decode_frame(frame, size, protocol::Direction::to_server);
   if (decoded.stream_broken()) return on_broken_stream(decoded);
-  if (hello_received() && !commands_.take(1.0, now))
+  // Acks answer snapshots, so their allowance follows the snapshot rate, not --max-commands.
+  const bool ack = decoded.ok() && decoded.message->payload_type() == wire::Payload::Ack;
+  if (hello_received() && !(ack ? ack_budget_ : commands_).take(1.0, now))
     return refuse(wire::ErrorCode::command_flood,
-                  "more than " + std::to_string(std::lround(info_.limits.max_commands_per_s)) +
-                      " messages a second (--max-commands)",
+                  ack ? "more than " + std::to_string(std::lround(2.0 * info_.snapshot_rate_hz)) +
+                            " acknowledgements a second (twice the snapshot rate)"
+                      : "more than " + std::to_string(std::lround(info_.limits.max_commands_per_s)) +
+                            " messages a second (--max-commands)",
                   /*disconnect=*/true);
   if (state_ == State::awaiting_hello) {
     if (!decoded.ok() || decoded.message->payload_type() != wire::Payload::Hello)
@@ -120,6 +125,12 @@ Outcome ClientProtocol::on_message(const wire::Message& message, Clock::time_poi
     case wire::Payload::Reset:
     case wire::Payload::SetTimeScale:
       return on_control(message);
+    case wire::Payload::Ack: {
+      const wire::Ack& ack = *message.payload_as_Ack();
+      if (std::string why = acks_.acknowledged(ack.tick(), ack.want_keyframe()); !why.empty())
+        return refuse(wire::ErrorCode::invalid_value, why, /*disconnect=*/false);
+      return out;
+    }
     default:  // decode_frame accepts nothing else in this direction
       return refuse(wire::ErrorCode::unexpected_message, "message type not accepted by the server", false);
   }

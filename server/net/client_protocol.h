@@ -18,6 +18,7 @@
 
 #include "protocol/frame_codec.h"
 #include "server/control_policy.h"
+#include "server/net/ack_tracker.h"
 #include "server/net/client_limits.h"
 #include "server/net/commands.h"
 #include "server/net/rate_budget.h"
@@ -78,6 +79,13 @@ class ClientProtocol {
   Outcome on_write_stalled(bool sent_meanwhile);
   Outcome on_replies_piling_up(std::size_t unsent);
 
+  // A Snapshot with this tick went out to the client.
+  void on_snapshot_sent(std::uint32_t tick) { acks_.sent(tick); }
+  // The snapshot the next one may be coded against; empty: send a keyframe.
+  std::optional<std::uint32_t> delta_base() const { return acks_.base(); }
+  // The snapshot sent before that one, to predict moving balls from; empty: none.
+  std::optional<std::uint32_t> delta_prior() const { return acks_.prior(); }
+
   // True from the Welcome on: the client gets snapshots.
   bool welcomed() const { return state_ == State::active; }
   bool hello_received() const { return state_ != State::awaiting_hello; }
@@ -102,7 +110,9 @@ class ClientProtocol {
   bool has_player_ = false;
   Clock::time_point last_move_;  // the last PlayerInput with a non-zero velocity, or the Welcome
   RateBudget commands_;
+  RateBudget ack_budget_;  // twice the snapshot rate: an Ack per snapshot, and room for a late burst
   RateBudget balls_;
+  AckTracker acks_;
 };
 
 }  // namespace fishtank::net

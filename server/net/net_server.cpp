@@ -103,6 +103,7 @@ void NetServer::stop() {
 
 void NetServer::post_snapshot(SharedSnapshot snapshot) {
   asio::post(io_, [this, snapshot = std::move(snapshot)] {
+    history_.publish(snapshot);
     // offer_snapshot() never closes a session synchronously, so sessions_ is stable here.
     for (const auto& [id, session] : sessions_) session->offer_snapshot(snapshot);
   });

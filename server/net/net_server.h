@@ -3,6 +3,7 @@
 //
 //   acceptor ──► Session (one per connection) ──commands──► CommandQueue ──► physics thread
 //   physics thread ──post_snapshot / post_reply──► io thread ──► the sessions
+//   the sessions ──snapshot_frame──► SnapshotHistory (a frame per acknowledged base)
 //
 // post_* are the only members called from another thread: they hand their
 // argument to the io thread with asio::post and return at once.
@@ -47,6 +48,12 @@ class NetServer final : public SessionOwner {
   void session_welcomed(Session& session) override;
   void session_closed(Session& session) override;
   void bytes_sent(std::size_t bytes) override;
+  CodedSnapshot snapshot_frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base,
+                               std::optional<std::uint32_t> prior) override {
+    return history_.frame(snapshot, base, prior);
+  }
+  // Coding of snapshot frames so far; safe to read from any thread.
+  const FrameStats& frame_stats() const { return history_.stats(); }
 
  private:
   void do_accept();
@@ -60,6 +67,7 @@ class NetServer final : public SessionOwner {
   ServerInfo info_;
   CommandQueue& commands_;
   std::unordered_map<std::uint32_t, std::shared_ptr<Session>> sessions_;
+  SnapshotHistory history_;
   std::uint32_t next_client_id_ = 1;
   bool stopped_ = false;
   // The current episode of failed accepts, and of newcomers refused while full.

@@ -63,16 +63,31 @@ std::string NetworkService::status() {
   const double io_cpu = io_thread_.joinable() ? thread_cpu_seconds(io_thread_) : 0.0;
   const double process_cpu = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID);
   const SnapshotStats& snapshots = link_.snapshot_stats();
+  const FrameStats& frames = server_.frame_stats();
+  const std::uint64_t frames_coded = frames.frames.load(std::memory_order_relaxed);
+  const std::uint64_t keyframes = frames.keyframes.load(std::memory_order_relaxed);
+  const double coding_seconds = 1e-9 * static_cast<double>(frames.coding_ns.load(std::memory_order_relaxed));
+  const std::uint64_t frame_bytes = frames.frame_bytes.load(std::memory_order_relaxed);
 
-  // Networking = the io thread plus snapshot encoding on the physics thread.
+  // Networking = the io thread (which codes the frames) plus the capture on the physics thread.
   const double net_cpu = (io_cpu - last_io_cpu_) + (snapshots.encode_seconds - last_encode_seconds_);
   const double process = process_cpu - last_process_cpu_;
   const std::uint64_t encoded = snapshots.encoded - last_encoded_;
-  char line[256];
-  std::snprintf(line, sizeof line, "clients %d  out %.2f MB/s  net cpu %.1f %% of process  snapshot %zu B in %.0f us",
+  const std::uint64_t coded = frames_coded - last_frames_;
+  // Per snapshot: its capture, plus every frame coded from it (one per distinct acknowledged base).
+  const double encode_us =
+      encoded ? 1e6 * ((snapshots.encode_seconds - last_encode_seconds_) + (coding_seconds - last_coding_seconds_)) /
+                    encoded
+              : 0.0;
+  char line[320];
+  std::snprintf(line, sizeof line,
+                "clients %d  out %.2f MB/s  net cpu %.1f %% of process  snapshot %.0f us to encode, %.2f frames of "
+                "%.0f B mean, %llu keyframes",
                 server_.clients(), window > 0.0 ? (bytes - last_bytes_) / window / 1e6 : 0.0,
-                process > 0.0 ? 100.0 * net_cpu / process : 0.0, snapshots.last_frame_bytes,
-                encoded ? 1e6 * (snapshots.encode_seconds - last_encode_seconds_) / encoded : 0.0);
+                process > 0.0 ? 100.0 * net_cpu / process : 0.0, encode_us,
+                encoded ? static_cast<double>(coded) / encoded : 0.0,
+                coded ? static_cast<double>(frame_bytes - last_frame_bytes_) / coded : 0.0,
+                static_cast<unsigned long long>(keyframes - last_keyframes_));
 
   last_status_ = now;
   last_bytes_ = bytes;
@@ -80,6 +95,10 @@ std::string NetworkService::status() {
   last_process_cpu_ = process_cpu;
   last_encode_seconds_ = snapshots.encode_seconds;
   last_encoded_ = snapshots.encoded;
+  last_frames_ = frames_coded;
+  last_keyframes_ = keyframes;
+  last_coding_seconds_ = coding_seconds;
+  last_frame_bytes_ = frame_bytes;
   return line;
 }
 

@@ -61,6 +61,8 @@ class NetworkService {
   std::uint64_t last_bytes_ = 0;
   double last_io_cpu_ = 0.0, last_process_cpu_ = 0.0, last_encode_seconds_ = 0.0;
   std::uint64_t last_encoded_ = 0;
+  std::uint64_t last_frames_ = 0, last_keyframes_ = 0, last_frame_bytes_ = 0;
+  double last_coding_seconds_ = 0.0;
 };
 
 }  // namespace fishtank::net

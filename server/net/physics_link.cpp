@@ -135,7 +135,6 @@ void PhysicsLink::publish_snapshot(const World& world, const LoopStatus& status)
   header.kinetic_energy_per_ball = kinetic_energy_per_ball_;
   header.contacts = contacts_;
   SharedSnapshot snapshot = encoder_.encode(world, header);
-  stats_.last_frame_bytes = snapshot->frame->size();
   stats_.encode_seconds += std::chrono::duration<double>(Clock::now() - start).count();
   ++stats_.encoded;
   publish_(std::move(snapshot));

@@ -4,7 +4,8 @@
 //   1. applies the commands the sessions queued (join, leave, velocity, add balls,
 //      and the sandbox's pause, step, reset and time scale) and hands each
 //      answer back to the io thread;
-//   2. encodes a snapshot when one is due (--snapshot-rate) and someone watches.
+//   2. captures a snapshot when one is due (--snapshot-rate) and someone watches
+//      (quantised once for every client; the io thread codes the frames).
 // Nothing here runs on the io thread, so the world needs no lock.
 
 #include <atomic>
@@ -29,8 +30,7 @@ struct PhysicsLinkOptions {
 // Measured on the physics thread; read there too (the status line).
 struct SnapshotStats {
   std::uint64_t encoded = 0;
-  double encode_seconds = 0.0;  // total
-  std::size_t last_frame_bytes = 0;
+  double encode_seconds = 0.0;  // total, of the capture (quantisation) only
 };
 
 class PhysicsLink {

@@ -123,20 +123,22 @@ void Session::do_write() {
   replies_.clear();
   for (const protocol::Frame& reply : writing_replies_) buffers.push_back(asio::buffer(reply));
   if (newest_snapshot_ && !close_after_write_) {
-    writing_snapshot_ = std::move(newest_snapshot_);
+    const SharedSnapshot snapshot = std::move(newest_snapshot_);
     newest_snapshot_.reset();
-    const std::uint32_t balls = writing_snapshot_->ball_count;
-    if (writing_snapshot_->scene_start != scene_start_) {
-      scene_start_ = writing_snapshot_->scene_start;
+    const std::uint32_t balls = snapshot->ball_count;
+    if (snapshot->scene_start != scene_start_) {
+      scene_start_ = snapshot->scene_start;
       kinds_sent_ = 0;  // new balls, new ids from 0
     }
     if (balls > kinds_sent_) {
-      writing_kinds_ = protocol::encode_ball_kinds(kinds_sent_, writing_snapshot_->kinds_by_id->data() + kinds_sent_,
-                                                   balls - kinds_sent_);
+      writing_kinds_ =
+          protocol::encode_ball_kinds(kinds_sent_, snapshot->kinds_by_id->data() + kinds_sent_, balls - kinds_sent_);
       kinds_sent_ = balls;
       buffers.push_back(asio::buffer(writing_kinds_));
     }
-    buffers.push_back(asio::buffer(*writing_snapshot_->frame));
+    writing_snapshot_ = owner_.snapshot_frame(snapshot, protocol_.delta_base(), protocol_.delta_prior()).frame;
+    protocol_.on_snapshot_sent(snapshot->header.tick);
+    buffers.push_back(asio::buffer(*writing_snapshot_));
   }
   if (buffers.empty()) {
     if (close_after_write_ && !farewell_sent_) {

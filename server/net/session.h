@@ -11,7 +11,9 @@
 //             write's stall deadline, the player sphere's idle deadline and, once
 //             the session is ending, the grace its last Error gets to be read.
 //   So a slow reader skips snapshots and never grows the server's memory or
-//   slows anyone else. Everything here runs on the io thread.
+//   slows anyone else. The snapshot is coded when its write starts, against
+//   the newest one the client acknowledged by then (a keyframe if none).
+//   Everything here runs on the io thread.
 //
 // Memory held for one connection: a buffer of at most kMaxFirstFrameBytes
 // before Hello, then at most about twice the bytes of the frame being received
@@ -28,7 +30,7 @@
 #include <vector>
 
 #include "server/net/client_protocol.h"
-#include "server/net/snapshot_encoder.h"
+#include "server/net/snapshot_history.h"
 
 namespace fishtank::net {
 
@@ -42,6 +44,9 @@ class SessionOwner {
   virtual void session_welcomed(Session& session) = 0;
   virtual void session_closed(Session& session) = 0;
   virtual void bytes_sent(std::size_t bytes) = 0;
+  // The frame of snapshot for a client that holds snapshots `base` (empty: none) and `prior`.
+  virtual CodedSnapshot snapshot_frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base,
+                                       std::optional<std::uint32_t> prior) = 0;
 };
 
 class Session : public std::enable_shared_from_this<Session> {
@@ -99,7 +104,7 @@ class Session : public std::enable_shared_from_this<Session> {
   // Kept alive while the write is in flight.
   std::vector<protocol::Frame> writing_replies_;
   protocol::Frame writing_kinds_;
-  SharedSnapshot writing_snapshot_;
+  protocol::SharedFrame writing_snapshot_;
   bool write_in_flight_ = false;
 
   bool close_after_write_ = false;

@@ -23,30 +23,29 @@ void SnapshotEncoder::extend_kinds(const World& world, std::uint32_t scene_start
 }
 
 SharedSnapshot SnapshotEncoder::encode(const World& world, const protocol::SnapshotHeader& header) {
+  auto published = std::make_shared<PublishedSnapshot>();
   const std::uint32_t n = world.ball_count();
   const TankBounds& tank = header.tank;
-  quantised_.resize(3 * std::size_t{n});
+  published->header = header;
+  published->ball_count = n;
+  published->quantised.resize(3 * std::size_t{n});
   const Float4* pos = world.positions();
   const std::uint32_t* ids = world.ids();
   for (std::uint32_t i = 0; i < n; ++i) {
     if (ids[i] >= n) continue;  // ids are dense (0 .. n-1); this only guards the write
-    protocol::quantize_position({pos[i].x, pos[i].y, pos[i].z}, tank, &quantised_[3 * std::size_t{ids[i]}]);
+    protocol::quantize_position({pos[i].x, pos[i].y, pos[i].z}, tank, &published->quantised[3 * std::size_t{ids[i]}]);
   }
 
   const std::size_t players = world.player_count();
-  player_ids_.assign(world.player_ids().begin(), world.player_ids().end());
-  player_positions_.resize(players);
+  published->player_ids.assign(world.player_ids().begin(), world.player_ids().end());
+  published->player_positions.resize(players);
   for (std::size_t p = 0; p < players; ++p) {
     const Float4& q = world.player_positions()[p];
-    player_positions_[p] = {q.x, q.y, q.z};
+    published->player_positions[p] = {q.x, q.y, q.z};
   }
 
   extend_kinds(world, header.scene_start);
-  auto published = std::make_shared<PublishedSnapshot>();
-  published->frame = std::make_shared<const protocol::Frame>(
-      protocol::encode_snapshot(header, quantised_.data(), n, player_ids_.data(), player_positions_.data(), players));
   published->kinds_by_id = kinds_by_id_;
-  published->ball_count = n;
   published->scene_start = header.scene_start;
   return published;
 }

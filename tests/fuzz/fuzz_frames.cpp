@@ -2,8 +2,10 @@
 // and as a server's byte stream to a client.
 //
 //   bytes ─► FrameReader(to_server) ─► ClientProtocol::on_frame ─► replies, commands
-//        │                                 └ on_reply(Joined / BallsAdded) after a Join
-//        └─► FrameReader(to_client) ─► every field a client reads
+//        │                                 └ on_reply(Joined / BallsAdded) after a Join,
+//        │                                   then snapshots sent (some skipped), so Acks count
+//        └─► FrameReader(to_client) ─► every field a client reads, and the positions
+//                                      of every Snapshot (deltas against the ones before)
 //
 // The first byte picks the chunk size the stream is cut into, so frame
 // boundaries land everywhere. A crash, a sanitizer report or an accepted frame
@@ -14,13 +16,16 @@
 #include <cstdlib>
 
 #include "protocol/frame_codec.h"
+#include "protocol/received_snapshots.h"
 #include "server/net/client_protocol.h"
 
 using namespace fishtank;
 
 namespace {
 
-const net::ServerInfo kInfo{"sse", "sse4.1", 2, TankBounds{}, 0.001f, 60.0f, net::ClientLimits{}};
+// Everyone may use the controls, so the fuzzer reaches them.
+const net::ServerInfo kInfo{
+    "sse", "sse4.1", 2, TankBounds{}, 0.001f, 60.0f, ControlPolicy::everyone, net::ClientLimits{}};
 
 void check(bool ok) {
   if (!ok) std::abort();
@@ -43,6 +48,9 @@ void drive_server(const std::uint8_t* data, std::size_t size, std::size_t chunk)
         net::Reply joined{1, net::JoinedReply{std::nullopt, "all player spheres are taken"}};
         for (const protocol::Frame& reply : conversation.on_reply(joined).replies)
           check(protocol::decode_frame(reply.data(), reply.size(), protocol::Direction::to_client).ok());
+        // Ticks 0 .. 39 sent, every fifth skipped: acks may be good, skipped, too old or in the future.
+        for (std::uint32_t tick = 0; tick < 40; ++tick)
+          if (tick % 5 != 4) conversation.on_snapshot_sent(tick);
       }
       if (outcome.disconnect || decoded->stream_broken()) return;
     }
@@ -53,7 +61,10 @@ void drive_server(const std::uint8_t* data, std::size_t size, std::size_t chunk)
 std::uint64_t read_all(const wire::Message& m) {
   std::uint64_t sum = 0;
   if (const auto* s = m.payload_as_Snapshot()) {
-    for (std::uint16_t q : *s->positions()) sum += q;
+    if (s->positions())
+      for (std::uint16_t q : *s->positions()) sum += q;
+    else
+      sum += s->unchanged()->size() + s->changes()->size();
     for (const wire::Vec3f* p : *s->player_positions()) sum += static_cast<std::uint64_t>(p->x() != 0.0f);
     for (std::uint32_t id : *s->player_ids()) sum += id;
   } else if (const auto* k = m.payload_as_BallKinds()) {
@@ -69,12 +80,20 @@ std::uint64_t read_all(const wire::Message& m) {
 
 void drive_client(const std::uint8_t* data, std::size_t size, std::size_t chunk) {
   protocol::FrameReader reader(protocol::Direction::to_client);
+  protocol::ReceivedSnapshots received;
+  std::vector<std::uint16_t> positions;
   volatile std::uint64_t sink = 0;
   for (std::size_t at = 0; at < size; at += chunk) {
     reader.append(data + at, std::min(chunk, size - at));
     while (auto decoded = reader.next()) {
       if (decoded->stream_broken()) return;
-      if (decoded->ok()) sink = sink + read_all(*decoded->message);
+      if (!decoded->ok()) continue;
+      sink = sink + read_all(*decoded->message);
+      if (const auto* s = decoded->message->payload_as_Snapshot()) {
+        // A delta it cannot rebuild gets a reason; one it can has every ball.
+        const std::string why = received.positions(*s, positions);
+        check(!why.empty() || positions.size() == 3 * std::size_t{s->ball_count()});
+      }
     }
   }
 }

@@ -402,3 +402,53 @@ TEST_CASE("a client the server drops says so and stops, instead of waiting out i
   REQUIRE_FALSE(summary.error_messages.empty());
   CHECK(summary.error_messages.back().find("dropped by the server") != std::string::npos);
 }
+
+TEST_CASE("a client that acknowledges gets deltas that decode to the positions a client without Acks gets in full",
+          "[net][delta]") {
+  ServerProcess server({"--balls", "600"});  // pouring: most balls move
+  Clients clients(server.port());
+  auto acking = clients.add(false);
+  auto full = clients.add(false);
+  full->acknowledge_snapshots(false);
+  int compared = 0;
+  for (int round = 0; round < 20; ++round) {
+    // Both read each snapshot within a few milliseconds: wait until they hold the same one.
+    const std::uint32_t after = acking->view().tick;
+    REQUIRE(clients.wait_until([&] { return acking->view().tick > after && acking->view().tick == full->view().tick; },
+                               std::chrono::seconds(5)));
+    CHECK(acking->view().positions == full->view().positions);
+    ++compared;
+    clients.run_for(std::chrono::milliseconds(100));
+  }
+  CHECK(compared == 20);
+  // On joining only (and while the first Ack is on its way, on a busy machine).
+  CHECK(acking->stats().keyframes <= 3);
+  CHECK(full->stats().keyframes == full->stats().snapshots);
+  CHECK(acking->stats().bytes_received < full->stats().bytes_received);
+  CHECK(acking->stats().errors.empty());
+}
+
+TEST_CASE("Acks that cannot be true get an Error and a keyframe; the connection and other clients go on",
+          "[net][delta]") {
+  ServerProcess server({"--balls", "300"});
+  Clients clients(server.port());
+  auto liar = clients.add(false);
+  auto other = clients.add(false);
+  REQUIRE(clients.wait_until([&] { return liar->stats().snapshots > 5 && other->stats().snapshots > 5; },
+                             std::chrono::seconds(5)));
+  const std::uint64_t keyframes = liar->stats().keyframes, others_keyframes = other->stats().keyframes;
+  liar->send(protocol::encode_ack(liar->view().tick + 1000));  // a snapshot not sent yet
+  REQUIRE(clients.wait_until([&] { return has_error(*liar, "invalid_value"); }, std::chrono::seconds(5)));
+  CHECK_THAT(liar->stats().errors.back(), Catch::Contains("not been sent yet"));
+  REQUIRE(clients.wait_until([&] { return liar->stats().keyframes > keyframes; }, std::chrono::seconds(5)));
+  liar->send(protocol::encode_ack(liar->view().tick, /*want_keyframe=*/true));
+  REQUIRE(clients.wait_until([&] { return liar->stats().keyframes > keyframes + 1; }, std::chrono::seconds(5)));
+
+  const std::uint64_t seen = liar->stats().snapshots;
+  clients.run_for(std::chrono::milliseconds(300));
+  CHECK(liar->stats().snapshots > seen);  // still connected, deltas again
+  CHECK_FALSE(liar->closed());
+  CHECK(other->stats().errors.empty());
+  CHECK(other->stats().keyframes == others_keyframes);
+  CHECK(server.running());
+}

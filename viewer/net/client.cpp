@@ -209,6 +209,7 @@ void NetClient::on_welcome(const wire::Welcome& w) {
   info->may_control = w.may_control();
   info_ = info;
   kinds_ = std::make_shared<std::vector<std::uint8_t>>();
+  received_.clear();
   connected_ = true;
   snapshots_.clear();
   update_status([&](ConnectionStatus& s) {
@@ -236,6 +237,14 @@ void NetClient::on_ball_kinds(const wire::BallKinds& k) {
 void NetClient::on_snapshot(const wire::Snapshot& s) {
   if (s.ball_count() > kinds_->size()) return lose("the server sent balls of unknown kind");
   auto snap = std::make_shared<Snapshot>();
+  if (std::string why = received_.positions(s, snap->quantised); !why.empty()) {
+    send(protocol::encode_ack(s.tick(), /*want_keyframe=*/true));
+    return update_status([&](ConnectionStatus& st) {
+      st.notice = why + "; asked for a keyframe";
+      st.notice_time = steady_seconds();
+    });
+  }
+  send(protocol::encode_ack(s.tick()));
   snap->tick = s.tick();
   snap->sim_time = s.sim_time();
   snap->received = steady_seconds();
@@ -251,7 +260,6 @@ void NetClient::on_snapshot(const wire::Snapshot& s) {
   snap->contacts = s.contacts();
   snap->tank = s.tank_min() ? TankBounds{to_vec3(*s.tank_min()), to_vec3(*s.tank_max())} : info_->tank;
   snap->ball_count = s.ball_count();
-  if (s.positions()) snap->quantised.assign(s.positions()->begin(), s.positions()->end());  // length checked
   snap->kinds = kinds_;
   if (s.player_ids())
     for (flatbuffers::uoffset_t i = 0; i < s.player_ids()->size(); ++i)

@@ -4,6 +4,7 @@
 //
 //   net thread (Boost.Asio)                          render thread
 //   connect ► Hello ► read frames ──decoded──► SnapshotBuffer ──► interpolate, draw
+//                  ◄ Ack per snapshot decoded (the server then sends deltas against it)
 //                  ◄ PlayerInput every 1/30 s ◄── set_velocity()
 //                  ◄ AddBalls                 ◄── add_balls()
 //                  ◄ Pause, Step, Reset, ...  ◄── send_command()
@@ -23,6 +24,7 @@
 #include <vector>
 
 #include "protocol/frame_codec.h"
+#include "protocol/received_snapshots.h"
 #include "viewer/net/snapshot_buffer.h"
 
 namespace fishtank::viewer {
@@ -92,6 +94,7 @@ class NetClient {
   std::deque<protocol::Frame> write_queue_;  // front is in flight
   std::shared_ptr<const ServerInfo> info_;
   std::shared_ptr<const std::vector<std::uint8_t>> kinds_;
+  protocol::ReceivedSnapshots received_;  // bases for delta snapshots
   std::uint32_t input_sequence_ = 0;
   std::uint64_t snapshots_this_second_ = 0;
   std::uint64_t bytes_this_second_ = 0;

@@ -1,0 +1,65 @@
+#pragma once
+// The io thread's store of recent snapshots, and the frames of the newest one.
+//
+//   physics thread ─► publish(s) ─► [ newest kKeptBases snapshots ]   the bases
+//   session ─► frame(newest, base, prior) ─► cache hit? ─► the same frame for every client with that base
+//                                     └ miss: code a delta against base (or a keyframe: no base,
+//                                       or one no longer kept), keep it for the next client
+//
+// Every client that acknowledged the same snapshot gets the same bytes, so
+// coding costs once per distinct base, not per client: on a quiet network all
+// clients acknowledge the previous snapshot and one delta serves them all. The
+// per-client part is a lookup in a cache of a few entries.
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <vector>
+
+#include "server/net/snapshot_encoder.h"
+
+namespace fishtank::net {
+
+struct CodedSnapshot {
+  protocol::SharedFrame frame;
+  bool keyframe = false;
+};
+
+// Read from the physics thread's status line; written on the io thread.
+struct FrameStats {
+  std::atomic<std::uint64_t> snapshots{0};  // published
+  std::atomic<std::uint64_t> frames{0};     // coded: keyframes and deltas
+  std::atomic<std::uint64_t> keyframes{0};
+  std::atomic<std::uint64_t> coding_ns{0};
+  std::atomic<std::uint64_t> frame_bytes{0};  // of every frame coded
+};
+
+class SnapshotHistory {
+ public:
+  // Bases kept at most, whatever their size, so that a huge tank keeps fewer
+  // snapshots rather than gigabytes.
+  static constexpr std::size_t kMaxBytes = std::size_t{256} << 20;
+
+  void publish(SharedSnapshot snapshot);
+  // The frame of `snapshot` for a client that holds `base` (empty: none) and
+  // `prior`, the snapshot sent to it before base (empty: none).
+  CodedSnapshot frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base,
+                      std::optional<std::uint32_t> prior = std::nullopt);
+  const FrameStats& stats() const { return stats_; }
+
+ private:
+  const PublishedSnapshot* find(std::uint32_t tick) const;
+  CodedSnapshot code(const PublishedSnapshot& snapshot, const PublishedSnapshot* base, const PublishedSnapshot* prior);
+
+  std::deque<SharedSnapshot> kept_;  // oldest first; the newest published is last
+  std::size_t kept_bytes_ = 0;
+  // Frames of the newest snapshot, by the base and prior they were coded against (empty: none).
+  using References = std::pair<std::optional<std::uint32_t>, std::optional<std::uint32_t>>;
+  std::vector<std::pair<References, CodedSnapshot>> cache_;
+  protocol::PositionsDelta delta_;  // scratch
+  FrameStats stats_;
+};
+
+}  // namespace fishtank::net
