@@ -51,11 +51,8 @@ bool same_box(const TankBounds& a, const TankBounds& b) {
 }
 
 // Mesa's software renderer (llvmpipe, e.g. under Xvfb) mallocs and frees
-// megabytes of vertex data every frame. By default glibc gives that memory
-// back to the kernel after each free and page-faults it in again on the next
-// frame: measured here at 1000 balls, 3.5 fps with 70 % of the time in the
-// kernel, and 20 fps once freed memory stays with the process. A GPU driver
-// is unaffected either way.
+// megabytes of vertex data every frame; glibc would give it back to the kernel
+// and page-fault it in again each frame. A GPU driver is unaffected.
 void keep_freed_memory() {
 #ifdef __GLIBC__
   mallopt(M_TRIM_THRESHOLD, 256 << 20);
