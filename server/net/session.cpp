@@ -201,7 +201,10 @@ void Session::check_limits() {
 
 void Session::on_error(const boost::system::error_code& ec, const char* on_eof) {
   if (ec == asio::error::operation_aborted) return;  // we closed the socket ourselves: not an error
-  close(ec == asio::error::eof ? on_eof : ec.message());
+  // Compared by value and category, without building a misc_errors error_code: that calls into
+  // Boost's category object, which UBSan caught mid-construction or mid-destruction at exit.
+  const bool eof = ec.value() == asio::error::eof && ec.category() == asio::error::get_misc_category();
+  close(eof ? on_eof : ec.message());
 }
 
 void Session::close(const std::string& reason) {
