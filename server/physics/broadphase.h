@@ -20,6 +20,7 @@
 #include <limits>
 #include <memory>
 #include <type_traits>
+#include <variant>
 #include <vector>
 
 #include "common/float4.h"
@@ -138,15 +139,24 @@ struct ListView {
   std::uint32_t operator[](std::uint32_t k) const { return listed_index(first[std::size_t(k) * lanes]); }
 };
 
-// The lists of the last build as a step reads them (the layout above): with
-// one lane, `counts` says where a list ends; with more, each group's record and blocks.
-struct StepLists {
+// The lists of the last build as a step reads them (the layout above), one
+// struct per layout: a twin reads the one its build wrote (Kernels::list_lanes).
+// One lane: ball i's list ends after counts[i] entries.
+struct BallLists {
   const std::uint32_t* neighbours = nullptr;
   std::uint32_t stride = 0;
-  const std::uint32_t* counts = nullptr;         // one lane
-  const std::uint32_t* group_records = nullptr;  // more lanes
-  const std::uint32_t* group_blocks = nullptr;   // more lanes
+  const std::uint32_t* counts = nullptr;
+  const Float4* at_build = nullptr;  // where the balls were at the build
 };
+// More lanes: per group its record (where its balls were at the build, and
+// their entries) and its number of blocks.
+struct GroupLists {
+  const std::uint32_t* neighbours = nullptr;
+  std::uint32_t stride = 0;
+  const std::uint32_t* records = nullptr;
+  const std::uint32_t* blocks = nullptr;
+};
+using StepLists = std::variant<BallLists, GroupLists>;
 
 // A SIMD build reads up to three balls past a cell range's end: arrays hold
 // n + kGhostSlots entries, the ghosts parked where they touch nothing.
@@ -243,11 +253,10 @@ class NeighbourList {
   const BatchReach* batch_reach() const { return reach_.data(); }
   const std::uint32_t* group_records() const { return group_records_.data(); }
   const std::uint32_t* group_blocks() const { return group_blocks_.data(); }
-  StepLists step_lists() const {
-    StepLists l;
-    l.neighbours = neighbours(), l.stride = stride_, l.counts = counts();
-    l.group_records = group_records(), l.group_blocks = group_blocks();
-    return l;
+  // The lists in the layout of the last reserve's lanes; at_build is where the balls were at the build.
+  StepLists step_lists(const Float4* at_build) const {
+    if (lanes_ == 1) return BallLists{neighbours(), stride_, counts(), at_build};
+    return GroupLists{neighbours(), stride_, group_records(), group_blocks()};
   }
   const RemoteRows* remote_rows() const { return remote_rows_.data(); }
 

@@ -28,15 +28,14 @@ struct StepArrays {
   // vx, vy, vz, 1 / mass half a step before: F / m becomes a product, and a
   // pair's effective mass 1 / (1/m1 + 1/m2) one sum.
   const Float4* vel_half = nullptr;
-  Float4* pos_next = nullptr;            // out: position one step later
-  Float4* vel_half_next = nullptr;       // out: velocity half a step later
-  const Float4* pos_at_build = nullptr;  // where the lists were built (the SIMD twins read the group records)
-  StepLists lists;                       // full lists, each pair from both sides (broadphase.h)
-  const Float4* player_pos = nullptr;    // x, y, z, radius
-  const Float4* player_vel = nullptr;    // vx, vy, vz, 0: a kinematic body's inverse mass
+  Float4* pos_next = nullptr;          // out: position one step later
+  Float4* vel_half_next = nullptr;     // out: velocity half a step later
+  StepLists lists;                     // full lists, each pair from both sides, in the twin's layout (broadphase.h)
+  const Float4* player_pos = nullptr;  // x, y, z, radius
+  const Float4* player_vel = nullptr;  // vx, vy, vz, 0: a kinematic body's inverse mass
   int players = 0;
-  // Balls whose pos_next lies further than sqrt(stray_d2) from pos_at_build
-  // have strayed: chunk [begin, end) lists its own, each once, at
+  // Balls whose pos_next lies further than sqrt(stray_d2) from where the
+  // lists were built have strayed: chunk [begin, end) lists its own, each once, at
   // stray_balls + begin, for the world to check (World::lists_hold).
   float stray_d2 = std::numeric_limits<float>::infinity();
   std::uint32_t* stray_balls = nullptr;
@@ -61,7 +60,7 @@ struct PrefetchPlan {
 
 // How far the balls of a chunk moved from where the lists were built.
 struct Moved {
-  float max_d2 = 0.0f;        // the largest squared distance of pos_next from pos_at_build
+  float max_d2 = 0.0f;        // the largest squared distance of pos_next from the build's position
   std::uint32_t strayed = 0;  // balls beyond StepArrays::stray_d2, listed at stray_balls + begin
 };
 

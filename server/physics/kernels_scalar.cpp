@@ -43,12 +43,13 @@ inline Float4 contact_force(const ContactModel& m, const Float4& pi, const Float
 }
 
 // The sum of the contact forces of ball i's neighbours, in list order.
-[[gnu::always_inline]] inline Float4 neighbour_forces(const StepArrays& s, const ContactModel& m, std::uint32_t i,
+[[gnu::always_inline]] inline Float4 neighbour_forces(const StepArrays& s, const BallLists& lists,
+                                                      const ContactModel& m, std::uint32_t i,
                                                       const std::uint32_t* list) {
   const Float4 pi = s.pos[i];
   const Float4 vi = s.vel_half[i];
   float fx = 0.0f, fy = 0.0f, fz = 0.0f;
-  for (std::uint32_t n = 0; n < s.lists.counts[i]; ++n) {
+  for (std::uint32_t n = 0; n < lists.counts[i]; ++n) {
     const Float4 f = contact_force(m, pi, vi, listed(s.pos, list[n]), listed(s.vel_half, list[n]));
     fx += f.x;
     fy += f.y;
@@ -81,6 +82,7 @@ Moved step(const StepArrays& arrays, const PrefetchPlan&, const ContactModel& mo
   // Local copies: stores through the output pointers cannot change them, so
   // pointers and constants stay in registers.
   const StepArrays s = arrays;
+  const BallLists lists = std::get<BallLists>(s.lists);
   const ContactModel m = model;
   Moved moved;
   // A batch's neighbour sums first, then the rest per ball: one loop doing
@@ -88,14 +90,14 @@ Moved step(const StepArrays& arrays, const PrefetchPlan&, const ContactModel& mo
   Float4 pair_force[kStepBatch];
   for (std::uint32_t batch = begin, last_of_batch; batch < end; batch = last_of_batch) {
     last_of_batch = batch_end(batch, end);
-    const std::uint32_t* list = s.lists.neighbours + std::size_t(batch) * s.lists.stride;
-    for (std::uint32_t i = batch; i < last_of_batch; list += s.lists.counts[i++])
-      pair_force[i - batch] = neighbour_forces(s, m, i, list);
+    const std::uint32_t* list = lists.neighbours + std::size_t(batch) * lists.stride;
+    for (std::uint32_t i = batch; i < last_of_batch; list += lists.counts[i++])
+      pair_force[i - batch] = neighbour_forces(s, lists, m, i, list);
     for (std::uint32_t i = batch; i < last_of_batch; ++i) {
       const Float4 a = acceleration(s, m, i, pair_force[i - batch]);
       const Float4 vh = s.vel_half[i];
       const Float4 v{vh.x + a.x * m.half_dt, vh.y + a.y * m.half_dt, vh.z + a.z * m.half_dt, vh.w};
-      const float d2 = kick_drift(m, v, s.pos[i], a, s.pos_at_build[i], s.vel_half_next[i], s.pos_next[i]);
+      const float d2 = kick_drift(m, v, s.pos[i], a, lists.at_build[i], s.vel_half_next[i], s.pos_next[i]);
       moved.max_d2 = std::max(moved.max_d2, d2);
       if (d2 > s.stray_d2) s.stray_balls[begin + moved.strayed++] = i;
     }
@@ -104,10 +106,11 @@ Moved step(const StepArrays& arrays, const PrefetchPlan&, const ContactModel& mo
 }
 
 void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin, std::uint32_t end) {
+  const BallLists& lists = std::get<BallLists>(s.lists);
   for (std::uint32_t batch = begin; batch < end; batch += kStepBatch) {
-    const std::uint32_t* list = s.lists.neighbours + std::size_t(batch) * s.lists.stride;
-    for (std::uint32_t i = batch; i < batch_end(batch, end); list += s.lists.counts[i++])
-      acc[i] = acceleration(s, m, i, neighbour_forces(s, m, i, list));
+    const std::uint32_t* list = lists.neighbours + std::size_t(batch) * lists.stride;
+    for (std::uint32_t i = batch; i < batch_end(batch, end); list += lists.counts[i++])
+      acc[i] = acceleration(s, m, i, neighbour_forces(s, lists, m, i, list));
   }
 }
 

@@ -295,21 +295,22 @@ inline void prefetch(const void* base, std::size_t bytes) {
 // This group's share of the rows, records and lists of the batch
 // kPrefetchBatches ahead, and of that batch's remote rows.
 template <std::uint32_t kCount>
-[[gnu::always_inline]] inline void prefetch_batch_ahead(const StepArrays& s, const PrefetchPlan& plan,
-                                                        std::uint32_t batch, std::uint32_t share) {
+[[gnu::always_inline]] inline void prefetch_batch_ahead(const StepArrays& s, const GroupLists& lists,
+                                                        const PrefetchPlan& plan, std::uint32_t batch,
+                                                        std::uint32_t share) {
   const std::size_t ahead = std::size_t(batch) + kPrefetchBatches * kStepBatch;
   const std::size_t rows = (ahead + share * kCount) * sizeof(Float4);
   for (std::size_t line = rows; line < rows + kCount * sizeof(Float4); line += kCacheLine) {
     prefetch<Reuse::kAgain>(s.pos, line);
     prefetch<Reuse::kAgain>(s.vel_half, line);
-    prefetch<Reuse::kOnce>(s.lists.group_records, line);  // 16 bytes per ball too, in the batch's group order
+    prefetch<Reuse::kOnce>(lists.records, line);  // 16 bytes per ball too, in the batch's group order
     prefetch<Reuse::kOnce>(s.pos_next, line);
     prefetch<Reuse::kOnce>(s.vel_half_next, line);
   }
   // A group's blocks take about eight entries (32 bytes) per lane.
-  const std::size_t lists = ahead * s.lists.stride * sizeof(std::uint32_t);
+  const std::size_t block = ahead * lists.stride * sizeof(std::uint32_t);
   for (std::size_t line = share * kCount * 32; line < (share + 1) * kCount * 32; line += kCacheLine)
-    prefetch<Reuse::kOnce>(s.lists.neighbours, lists + line);
+    prefetch<Reuse::kOnce>(lists.neighbours, block + line);
   const std::size_t remote_batch = ahead / kStepBatch;
   if (remote_batch >= plan.batches) return;
   const RemoteRows& remote = plan.remote_rows[remote_batch];
@@ -342,19 +343,20 @@ template <std::uint32_t kCount>
 // A batch's groups, one ball per lane: a = F / m + g, then per_group(at, i, ax, ay, az, record)
 // does the rest for the balls at list entries `at`.
 template <class V, class PerGroup>
-[[gnu::always_inline]] inline void for_each_group_of_batch(const StepArrays& s, const PrefetchPlan& plan,
-                                                           const ContactModel& m, std::uint32_t batch,
-                                                           std::uint32_t end, PerGroup& per_group) {
+[[gnu::always_inline]] inline void for_each_group_of_batch(const StepArrays& s, const GroupLists& lists,
+                                                           const PrefetchPlan& plan, const ContactModel& m,
+                                                           std::uint32_t batch, std::uint32_t end,
+                                                           PerGroup& per_group) {
   constexpr std::uint32_t kCount = Lanes<V>::kCount;
-  const std::uint32_t* block = s.lists.neighbours + std::size_t(batch) * s.lists.stride;
+  const std::uint32_t* block = lists.neighbours + std::size_t(batch) * lists.stride;
   const std::uint32_t groups = grouped_length(batch_end(batch, end) - batch, kCount) / kCount;
-  const std::uint32_t* const group_blocks = s.lists.group_blocks + batch / kCount;
-  const std::uint32_t* record = s.lists.group_records + 4 * std::size_t(batch);
+  const std::uint32_t* const group_blocks = lists.blocks + batch / kCount;
+  const std::uint32_t* record = lists.records + 4 * std::size_t(batch);
   // Decided once per batch: most batches are in no fetch's window (all, on one thread).
   const std::uint32_t batch_number = batch / kStepBatch;
   const bool fetching = in_window(plan.edge_fetch[0], batch_number) || in_window(plan.edge_fetch[1], batch_number);
   for (std::uint32_t share = 0; share < groups; ++share, record += 4 * kCount) {
-    if (plan.beyond_cache) prefetch_batch_ahead<kCount>(s, plan, batch, share);
+    if (plan.beyond_cache) prefetch_batch_ahead<kCount>(s, lists, plan, batch, share);
     if (fetching)
       for (const RowFetch& f : plan.edge_fetch) fetch_rows<kCount>(s, f, batch_number, share);
     const std::uint32_t blocks = group_blocks[share];
@@ -374,12 +376,13 @@ template <class V, class PerGroup>
 template <class V, class PerGroup>
 [[gnu::always_inline]] inline void for_each_group(const StepArrays& s, const PrefetchPlan& plan, const ContactModel& m,
                                                   std::uint32_t begin, std::uint32_t end, PerGroup per_group) {
+  const GroupLists lists = std::get<GroupLists>(s.lists);
   const bool led = plan.lead_begin < plan.lead_end;
   const std::uint32_t lead_begin = led ? plan.lead_begin : begin, lead_end = led ? plan.lead_end : begin;
   const std::uint32_t from[3] = {lead_begin, begin, lead_end}, to[3] = {lead_end, lead_begin, end};
   for (int part = 0; part < 3; ++part)
     for (std::uint32_t batch = from[part]; batch < to[part]; batch += kStepBatch)
-      for_each_group_of_batch<V>(s, plan, m, batch, end, per_group);
+      for_each_group_of_batch<V>(s, lists, plan, m, batch, end, per_group);
 }
 
 template <class V>

@@ -265,8 +265,7 @@ StepArrays World::arrays() {
   s.vel_half = vel_half_.data();
   s.pos_next = pos_next_.data();
   s.vel_half_next = vel_half_next_.data();
-  s.pos_at_build = pos_at_build_.data();
-  s.lists = list_.step_lists();
+  s.lists = list_.step_lists(pos_at_build_.data());
   s.player_pos = player_pos_.data();
   s.player_vel = player_vel_.data();
   s.players = static_cast<int>(player_pos_.size());

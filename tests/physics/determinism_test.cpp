@@ -142,11 +142,6 @@ TEST_CASE("a pile beyond the caches is bit-identical for 1 and 2 threads, its re
 
 namespace {
 
-// Where a step finds the lists (broadphase.h's layout).
-struct LayoutView {
-  const std::uint32_t *neighbours, *group_records, *group_blocks;
-};
-
 // n densely packed random balls of every kind (many in contact), in cell
 // order, with their lists as a kernel set builds them.
 struct DenseScene {
@@ -183,17 +178,14 @@ struct DenseScene {
   // One step by the kernel, called on the given consecutive ranges of balls,
   // with the lists laid out as `layout` says; returns every output value's bits.
   std::vector<std::uint32_t> step_bits(const Kernels& kernels, const std::vector<std::uint32_t>& bounds,
-                                       const LayoutView& layout) const {
+                                       const GroupLists& layout) const {
     AlignedVector<Float4> pos_next(n), vel_half_next(n);
     StepArrays s;
-    s.pos = s.pos_at_build = pos.data();
+    s.pos = pos.data();
     s.vel_half = vel_half.data();
     s.pos_next = pos_next.data();
     s.vel_half_next = vel_half_next.data();
-    s.lists = list.step_lists();
-    s.lists.neighbours = layout.neighbours;
-    s.lists.group_records = layout.group_records;
-    s.lists.group_blocks = layout.group_blocks;
+    s.lists = layout;
     for (std::size_t r = 0; r + 1 < bounds.size(); ++r)
       kernels.step(s, PrefetchPlan{}, model, bounds[r], bounds[r + 1]);
     std::vector<std::uint32_t> bits;
@@ -215,7 +207,9 @@ struct Layout {
   std::vector<std::uint32_t> neighbours;
   AlignedVector<std::uint32_t> group_records;
   std::vector<std::uint32_t> group_blocks;
-  LayoutView view() const { return {neighbours.data(), group_records.data(), group_blocks.data()}; }
+  GroupLists view(std::uint32_t stride) const {
+    return {neighbours.data(), stride, group_records.data(), group_blocks.data()};
+  }
 };
 
 Layout shuffled_groups(const DenseScene& scene, std::uint32_t lanes) {
@@ -263,10 +257,10 @@ TEST_CASE("a ball's step does not depend on which balls share its vector", "[phy
   for (const Kernels* kernels : simd) {
     INFO(kernels->variant);
     const DenseScene scene(*kernels, 300);
-    const LayoutView as_built{scene.list.neighbours(), scene.list.group_records(), scene.list.group_blocks()};
+    const GroupLists as_built = std::get<GroupLists>(scene.list.step_lists(scene.pos.data()));
     const std::vector<std::uint32_t> built = scene.step_bits(*kernels, {0, 300}, as_built);
     CHECK(scene.step_bits(*kernels, {0, kStepBatch, 2 * kStepBatch, 300}, as_built) == built);
     const Layout shuffled = shuffled_groups(scene, kernels->list_lanes);
-    CHECK(scene.step_bits(*kernels, {0, 300}, shuffled.view()) == built);
+    CHECK(scene.step_bits(*kernels, {0, 300}, shuffled.view(scene.list.stride())) == built);
   }
 }
