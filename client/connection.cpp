@@ -150,6 +150,7 @@ void Connection::on_snapshot(const wire::Snapshot& s) {
   view_.scene_start = s.scene_start();
   view_.kinetic_energy_per_ball = s.kinetic_energy_per_ball();
   view_.contacts = s.contacts();
+  view_.max_overlap = s.max_overlap();
   if (s.tank_min()) {  // decode_frame checked that both are present and ordered
     tank_.min = {s.tank_min()->x(), s.tank_min()->y(), s.tank_min()->z()};
     tank_.max = {s.tank_max()->x(), s.tank_max()->y(), s.tank_max()->z()};

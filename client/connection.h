@@ -51,6 +51,7 @@ struct WorldView {
   std::uint32_t scene_start = 0;  // +1 per scene (re)start: ball ids restart
   float kinetic_energy_per_ball = 0.0f;
   std::uint32_t contacts = 0;
+  float max_overlap = 0.0f;  // Snapshot.max_overlap
   std::uint32_t ball_count = 0;
   std::vector<std::uint16_t> positions;  // quantised, 3 per ball (protocol/quantize.h)
   std::vector<std::uint8_t> kinds;       // by ball id, from BallKinds

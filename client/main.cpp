@@ -55,6 +55,7 @@ int main(int argc, char** argv) {
                         {"worker_threads", s.worker_threads},
                         {"time_scale", s.time_scale},
                         {"time_scale_set", s.time_scale_set},
+                        {"max_overlap", s.max_overlap},
                         {"paused", s.paused},
                         {"scene", s.scene},
                         {"scene_start", s.scene_start},

@@ -48,6 +48,7 @@ Summary summarise(const std::vector<std::shared_ptr<Connection>>& connections, d
       s.threads_stepping = c->view().threads_stepping;
       s.time_scale = c->view().time_scale;
       s.time_scale_set = c->view().time_scale_set;
+      s.max_overlap = c->view().max_overlap;
       s.paused = c->view().paused;
       s.scene = c->view().scene;
       s.scene_start = c->view().scene_start;

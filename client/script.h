@@ -58,6 +58,7 @@ struct Summary {
   std::uint32_t worker_threads = 0;
   double time_scale = 0.0;      // simulated seconds per wall second; 0: not reported
   double time_scale_set = 0.0;  // asked for; 0: not reported
+  double max_overlap = 0.0;     // largest overlap, a fraction of the smaller radius
   bool paused = false;
   std::string scene;
   std::uint32_t scene_start = 0;

@@ -160,8 +160,8 @@ std::string check_values(const wire::Message& m) {
         if (!finite(p)) return "Snapshot has a non-finite player position";
       if (!std::isfinite(s.sim_time()) || !std::isfinite(s.steps_per_s()) || !std::isfinite(s.load()) ||
           !std::isfinite(s.time_scale()) || !std::isfinite(s.time_scale_set()) ||
-          !std::isfinite(s.kinetic_energy_per_ball()))
-        return "Snapshot has a non-finite time, rate, load, time scale or energy";
+          !std::isfinite(s.kinetic_energy_per_ball()) || !std::isfinite(s.max_overlap()))
+        return "Snapshot has a non-finite time, rate, load, time scale, energy or overlap";
       if (!s.tank_min() != !s.tank_max()) return "Snapshot has one tank corner without the other";
       if (s.tank_min() && !ordered_box(s.tank_min(), s.tank_max()))
         return "Snapshot tank bounds are not finite, or tank_min is not below tank_max on every axis";
@@ -285,6 +285,7 @@ Frame encode_snapshot_with(const SnapshotHeader& header, std::uint32_t ball_coun
   s.add_tank_max(&tank_max);
   s.add_kinetic_energy_per_ball(header.kinetic_energy_per_ball);
   s.add_contacts(header.contacts);
+  s.add_max_overlap(header.max_overlap);
   positions.add_to(s);
   return finish(b, s.Finish());
 }

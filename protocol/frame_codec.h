@@ -100,6 +100,7 @@ struct SnapshotHeader {
   TankBounds tank;  // the running scene's: the quantisation bounds
   float kinetic_energy_per_ball = 0.0f;
   std::uint32_t contacts = 0;
+  float max_overlap = 0.0f;  // fraction of the smaller radius
 };
 // quantised holds 3 * ball_count values (protocol/quantize.h), in ball-id order;
 // player_ids and player_positions hold `players` entries each.

@@ -54,9 +54,18 @@ int write_final_state(const fishtank::World& world, const fishtank::ServerOption
   return 1;
 }
 
+// --max-balls, refused when the tank cannot hold that many.
+bool apply_max_balls(fishtank::World& world, const fishtank::ServerOptions& o) {
+  if (o.max_balls == 0) return true;
+  const std::string refusal = world.set_max_balls(o.max_balls);
+  if (!refusal.empty()) std::cerr << "fishtank-server: --max-balls: " << refusal << "\n";
+  return refusal.empty();
+}
+
 int run_bench(const fishtank::ServerOptions& o) {
   fishtank::World world(o.physics, kKernels, o.threads, o.bench_spec.scene.seed);
   world.set_thread_tuning(!o.fixed_threads);
+  if (!apply_max_balls(world, o)) return 2;
   if (std::string refusal = fishtank::populate(world, o.bench_spec.scene); !refusal.empty()) {
     std::cerr << "fishtank-server: " << refusal << "\n";
     return 2;
@@ -67,6 +76,8 @@ int run_bench(const fishtank::ServerOptions& o) {
               << " simulated seconds; timing anyway\n";
   std::cerr << "timing " << o.bench_spec.steps << " steps of " << world.ball_count() << " balls\n";
   nlohmann::json report = fishtank::time_steps(world, o.bench_spec, settled);
+  if (const std::string warning = world.overlap_warning(); !warning.empty())
+    std::cerr << "fishtank-server: warning: " << warning << "\n";
   std::cout << report.dump(2) << std::endl;
   return write_final_state(world, o);
 }
@@ -130,6 +141,7 @@ int run_server(const fishtank::ServerOptions& o) {
   params.tank = scene.first_tank();
   fishtank::World world(params, kKernels, o.threads, o.bench_spec.scene.seed);
   world.set_thread_tuning(!o.fixed_threads);
+  if (!apply_max_balls(world, o)) return 2;
   if (std::string refusal = scene.start(world); !refusal.empty()) std::cerr << "fishtank-server: " << refusal << "\n";
   fishtank::RunControl control;
   const int cores = fishtank::WorkerPool::hardware_threads();
@@ -161,10 +173,12 @@ int run_server(const fishtank::ServerOptions& o) {
     next_frame = w.steps() + o.record_every;
   };
   loop.on_status = [&network, &control, &scene, cores](const fishtank::World& w, const fishtank::LoopStatus& s) {
-    std::fprintf(stderr, "t = %7.1f s  balls %5u (+%u queued)  %6.0f steps/s  load %5.1f %% on %s  %s  scene %s%s\n",
+    const std::string warning = w.overlap_warning();
+    std::fprintf(stderr,
+                 "t = %7.1f s  balls %5u (+%u queued)  %6.0f steps/s  load %5.1f %% on %s  %s  scene %s%s%s%s\n",
                  w.time(), w.ball_count(), w.pending(), s.steps_per_s, 100.0 * s.load,
                  threads_text(s.threads, cores).c_str(), network.status().c_str(), scene.name().c_str(),
-                 pace_text(s, control).c_str());
+                 pace_text(s, control).c_str(), warning.empty() ? "" : "  WARNING: ", warning.c_str());
   };
   fishtank::run_realtime(world, loop, g_stop);
   std::cerr << "fishtank-server: stopped after " << world.steps() << " steps, " << world.ball_count() << " balls\n";

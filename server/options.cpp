@@ -37,7 +37,8 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "seed", po::value(&seed)->default_value(seed), "random seed for spawning, >= 0")(
       "scene", po::value(&o.bench_spec.scene.name)->default_value("tank"), scene_help().c_str())(
       "balls", po::value(&balls), "balls of every scene (default: the scene's, 1000 for tank; with --bench, 6000)")(
-      "max-balls", po::value(&max_balls)->default_value(0), "most balls the tank may hold (0: its capacity, ~6100)")(
+      "max-balls", po::value(&max_balls)->default_value(0),
+      "most balls the tank may hold (0: its capacity, ~6100; more is refused)")(
       "duration", po::value(&o.duration)->default_value(0.0), "stop after this many seconds (0: run until Ctrl-C)")(
       "status-interval", po::value(&o.status_interval)->default_value(1.0), "seconds between status lines");
 
@@ -102,7 +103,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "windows", po::value(&windows)->default_value(windows),
       "the timed steps are split into this many windows; rates are their median")(
       "settle-time", po::value(&settle_time)->default_value(0.0),
-      "most simulated seconds to wait for rest (0: 90 for tank, 4 for wide)");
+      "most simulated seconds to wait for rest, 1e-6 J per ball (0: 300 for tank, 4 for wide)");
 
   po::options_description all;
   all.add(general).add(network).add(guard).add(physics).add(bench).add(output);

@@ -94,11 +94,20 @@ void Hud::stats(const HudView& v) {
     row(live, "Time", "%s", time_scale_text(s->time_scale, s->time_scale_set, s->paused).c_str());
     row(live, "Scene", "%s (start %u)", s->scene.empty() ? "-" : s->scene.c_str(), s->scene_start);
     row(live, "Balls", "%u", s->ball_count);
+    const OverlapText overlap = overlap_text(s->max_overlap);
+    if (overlap.warn && live) {
+      ImGui::TextColored(kDim, "Overlap");
+      ImGui::SameLine(110.0f);
+      ImGui::TextColored(kWarn, "%s", overlap.text.c_str());
+    } else {
+      row(live, "Overlap", "%s", overlap.text.c_str());
+    }
   } else {
     row(live, "Physics", "-");
     row(live, "Time", "-");
     row(live, "Scene", "-");
     row(live, "Balls", "-");
+    row(live, "Overlap", "-");
   }
   if (const ServerInfo* info = net.info.get()) {
     row(live, "Threads", "%s", threads_text(s ? s->threads_stepping : 0, info->threads).c_str());

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "common/overlap.h"
 #include "common/time_scale.h"
 
 namespace fishtank::viewer {
@@ -24,6 +25,14 @@ std::string threads_text(std::uint32_t stepping, int available) {
   else
     std::snprintf(text, sizeof text, "stepping on %u of %d thread%s", stepping, available, plural);
   return text;
+}
+
+OverlapText overlap_text(float fraction) {
+  char text[96];
+  const bool warn = overlap_too_deep(fraction);
+  std::snprintf(text, sizeof text, "%.1f %% of the smaller radius%s", 100.0 * fraction,
+                warn ? ": stiffness too soft for the load" : "");
+  return {text, warn};
 }
 
 std::string time_scale_text(float time_scale, float time_scale_set, bool paused) {

@@ -26,6 +26,14 @@ std::string threads_text(std::uint32_t stepping, int available);
 // not say. time_scale_set 0 (not reported) counts as 1.
 std::string time_scale_text(float time_scale, float time_scale_set = 1.0f, bool paused = false);
 
+// The largest overlap (Snapshot.max_overlap, a fraction of the smaller radius):
+// "4.2 % of the smaller radius", and whether it is deep enough to warn about.
+struct OverlapText {
+  std::string text;
+  bool warn = false;
+};
+OverlapText overlap_text(float fraction);
+
 // Who may use the sandbox's controls, for the HUD: this viewer's part first.
 std::string control_text(bool may_control, const std::string& policy);
 

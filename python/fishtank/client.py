@@ -52,6 +52,7 @@ class Snapshot:
     steps_per_s: float
     kinetic_energy_per_ball: float  # joules
     contacts: int
+    max_overlap: float  # largest overlap, a fraction of the smaller radius; beyond 0.1 k is too soft
     tank_min: np.ndarray  # (3,) float32
     tank_max: np.ndarray
 
@@ -363,6 +364,7 @@ class Client:
             steps_per_s=s.StepsPerS(),
             kinetic_energy_per_ball=s.KineticEnergyPerBall(),
             contacts=s.Contacts(),
+            max_overlap=s.MaxOverlap(),
             tank_min=lo,
             tank_max=hi,
         )

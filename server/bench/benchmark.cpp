@@ -72,6 +72,7 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   j["k"] = world.params().stiffness;
   j["restitution"] = world.params().restitution;
   j["max_overlap"] = world.max_overlap_fraction();
+  j["overlap_warning"] = world.overlap_warning();  // empty while the largest overlap is within kOverlapWarning
   j["pile_top"] = world.pile_top();
   j["tank"] = {{"min", {tank.min.x, tank.min.y, tank.min.z}}, {"max", {tank.max.x, tank.max.y, tank.max.z}}};
   j["mean_neighbours"] = world.mean_neighbours();
@@ -79,6 +80,7 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   // Steps that kept the lists after checking the balls that moved past skin/2.
   j["lists_kept_after_check"] = world.lists_kept_by_checks() - kept_before;
   j["kinetic_energy_per_ball"] = world.ball_count() ? world.kinetic_energy() / world.ball_count() : 0.0;
+  j["max_speed"] = world.max_speed();  // the fastest ball, m/s
   j["settle"] = {{"settled", settle.settled},
                  {"sim_seconds", settle.sim_seconds},
                  {"wall_seconds", settle.wall_seconds},

@@ -7,7 +7,7 @@
 namespace fishtank {
 
 SettleReport settle(World& world, const SceneSpec& spec) {
-  const double limit = spec.max_settle_seconds > 0.0 ? spec.max_settle_seconds : (spec.name == "wide" ? 4.0 : 90.0);
+  const double limit = spec.max_settle_seconds > 0.0 ? spec.max_settle_seconds : (spec.name == "wide" ? 4.0 : 300.0);
   const auto start = std::chrono::steady_clock::now();
   const std::uint64_t first_step = world.steps();
   // Checked every tenth of a simulated second, reported every tenth check.
@@ -21,7 +21,7 @@ SettleReport settle(World& world, const SceneSpec& spec) {
     const double sim = done * double(world.dt());
     const double energy = world.ball_count() ? world.kinetic_energy() / world.ball_count() : 0.0;
     if (done / check_every % kChecksPerReport == 0)
-      std::fprintf(stderr, "settling: %.0f s simulated, %u balls in, %u queued, kinetic energy %.4f J/ball\n", sim,
+      std::fprintf(stderr, "settling: %.0f s simulated, %u balls in, %u queued, kinetic energy %.2g J/ball\n", sim,
                    world.ball_count(), world.pending(), energy);
     report.settled = world.pending() == 0 && energy < kRestEnergy;
     if (report.settled || sim >= limit) {

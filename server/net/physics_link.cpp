@@ -114,6 +114,7 @@ void PhysicsLink::refresh_figures(const World& world, Clock::time_point now) {
   kinetic_energy_per_ball_ =
       world.ball_count() ? static_cast<float>(world.kinetic_energy() / world.ball_count()) : 0.0f;
   contacts_ = world.contact_count();
+  max_overlap_ = world.max_overlap_fraction();
 }
 
 void PhysicsLink::publish_snapshot(const World& world, const LoopStatus& status) {
@@ -134,6 +135,7 @@ void PhysicsLink::publish_snapshot(const World& world, const LoopStatus& status)
   refresh_figures(world, start);
   header.kinetic_energy_per_ball = kinetic_energy_per_ball_;
   header.contacts = contacts_;
+  header.max_overlap = max_overlap_;
   SharedSnapshot snapshot = encoder_.encode(world, header);
   stats_.encode_seconds += std::chrono::duration<double>(Clock::now() - start).count();
   ++stats_.encoded;

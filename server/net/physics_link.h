@@ -77,6 +77,7 @@ class PhysicsLink {
   std::uint32_t figures_start_ = 0;  // the scene start they were measured in
   float kinetic_energy_per_ball_ = 0.0f;
   std::uint32_t contacts_ = 0;
+  float max_overlap_ = 0.0f;
   Clock::time_point next_reset_ = Clock::time_point::min();
 };
 

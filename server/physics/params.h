@@ -6,9 +6,15 @@
 //   pair damping     c    = 2 zeta sqrt(k m_eff),   m_eff = m1 m2 / (m1 + m2)
 //   contact duration t_c  = pi sqrt(m_eff,min / k)   (undamped half period)
 //   time step        dt   = t_c / steps_per_contact
+//
+// m_eff,min is the lightest pair's (two balls of the lightest kind; a wall or
+// the player, being kinematic, gives a ball its own mass, twice that). Damping
+// lengthens a contact (by 39 % at e = 0.05), but the damped oscillator's rates
+// still have magnitude w0 = pi / t_c, so the undamped t_c sets dt.
 
 #include <string>
 
+#include "common/overlap.h"
 #include "common/tank.h"
 
 namespace fishtank {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 
@@ -18,6 +19,8 @@ constexpr Float4 kGhostVel{0.0f, 0.0f, 0.0f, 1.0f};  // mass 1: the same as vel_
 
 // vel_ carries each ball's mass, as observers expect; the kernels' half-step rows carry 1 / mass.
 Float4 half_step_row(const Float4& vel) { return {vel.x, vel.y, vel.z, 1.0f / vel.w}; }
+
+float squared_speed(const Float4& v) { return v.x * v.x + v.y * v.y + v.z * v.z; }
 
 class PhaseTimer {
  public:
@@ -460,6 +463,13 @@ double World::kinetic_energy() const {
   return e;
 }
 
+float World::max_speed() const {
+  derive_velocities();
+  float fastest2 = 0.0f;
+  for (std::uint32_t i = 0; i < n_; ++i) fastest2 = std::max(fastest2, squared_speed(vel_[i]));
+  return std::sqrt(fastest2);
+}
+
 double World::potential_energy() const {
   derive_velocities();  // vel_'s w is the mass, also of balls placed since the last step
   double e = 0.0;
@@ -487,6 +497,28 @@ double World::elastic_energy() const {
       if (overlap > 0.0) sum_x2 += overlap * overlap;
   }
   return 0.5 * model_.k * sum_x2;
+}
+
+std::string World::set_max_balls(std::uint32_t max_balls) {
+  if (max_balls <= capacity_) {
+    max_balls_ = max_balls;
+    return "";
+  }
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "the tank holds at most %u balls of the default mix (packing fraction %.2g); asked for %u", capacity_,
+                double(kPackingLimit), max_balls);
+  return text;
+}
+
+std::string World::overlap_warning() const {
+  const float overlap = max_overlap_fraction();
+  if (!overlap_too_deep(overlap)) return "";
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "largest overlap %.0f %% of the smaller radius (over %.0f %%): k = %g N/m is too soft", 100.0 * overlap,
+                100.0 * kOverlapWarning, double(model_.k));
+  return text;
 }
 
 std::uint32_t World::contact_count() const {

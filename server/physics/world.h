@@ -65,7 +65,8 @@ class World {
   // Puts one ball exactly there, without any overlap check (scenes and tests); it may touch others,
   // so the next step starts with a force pass.
   void place_ball(int kind, Vec3 pos, Vec3 vel);
-  void set_max_balls(std::uint32_t max_balls) { max_balls_ = max_balls; }
+  // Empty when accepted; a refusal saying what fits when max_balls exceeds capacity().
+  std::string set_max_balls(std::uint32_t max_balls);
   // Empties the world into a (possibly different) tank, for a scene's start:
   // no balls, nothing queued, spawning reseeded, max_balls() the new capacity.
   // The clock and step count go on (viewers interpolate over them); players
@@ -132,6 +133,7 @@ class World {
   BallView ball(std::uint32_t id) const;
 
   double kinetic_energy() const;
+  float max_speed() const;          // the fastest ball's, m/s
   double potential_energy() const;  // gravity, relative to y = 0
   double elastic_energy() const;    // springs of every contact: sum of k x^2 / 2
   // Overlapping ball pairs and ball-wall contacts (0 before the first step).
@@ -141,6 +143,9 @@ class World {
   double energy_added() const { return energy_added_; }
   // Largest overlap (ball-ball, ball-wall), as a fraction of the smaller radius.
   float max_overlap_fraction() const;
+  // Whether max_overlap_fraction() is past kOverlapWarning, and a sentence that
+  // says so (empty otherwise): a softer k than the scene's load allows.
+  std::string overlap_warning() const;
   float pile_top() const;  // highest point of any ball
   // Balls whose centre is outside the tank or whose state is not finite.
   std::uint32_t escaped_or_invalid() const;

@@ -16,6 +16,7 @@ std::string ActiveScene::start(World& world, const std::optional<std::string>& s
   if (seed) choice_.seed = *seed;
   const SceneSpec s = spec();
   world.restart(scene_tank(s), s.seed);
+  // Refused by a scene whose tank holds fewer: its capacity is then the limit.
   if (choice_.max_balls > 0) world.set_max_balls(choice_.max_balls);
   std::string refusal = populate(world, s);
   world.respawn_players();

@@ -72,6 +72,7 @@ TEST_CASE("every message survives encode then decode with its values intact", "[
     h.tank.min = {-50.0f, 0.0f, -30.0f};
     h.kinetic_energy_per_ball = 0.25f;
     h.contacts = 1234;
+    h.max_overlap = 0.125f;
     const protocol::Frame f = protocol::encode_snapshot(h, q.data(), 2, ids, players, 2);
     const auto r = decode(f, Direction::to_client);
     REQUIRE(r.ok());
@@ -88,6 +89,7 @@ TEST_CASE("every message survives encode then decode with its values intact", "[
     CHECK(s.tank_max()->x() == 20.0f);
     CHECK(s.kinetic_energy_per_ball() == 0.25f);
     CHECK(s.contacts() == 1234);
+    CHECK(s.max_overlap() == 0.125f);
     CHECK(std::vector<std::uint16_t>(s.positions()->begin(), s.positions()->end()) == q);
     CHECK(s.player_ids()->Get(1) == 9);
     CHECK(s.player_positions()->Get(1)->z() == -6.0f);

@@ -7,6 +7,16 @@
 
 using namespace fishtank::viewer;
 
+TEST_CASE("an overlap beyond a tenth of the smaller radius is a warning, a lighter one a plain figure") {
+  const OverlapText light = overlap_text(0.042f);
+  CHECK(light.text == "4.2 % of the smaller radius");
+  CHECK_FALSE(light.warn);
+  CHECK_FALSE(overlap_text(0.10f).warn);  // the limit itself is still accepted
+  const OverlapText deep = overlap_text(0.52f);
+  CHECK(deep.warn);
+  CHECK(deep.text == "52.0 % of the smaller radius: stiffness too soft for the load");
+}
+
 TEST_CASE("while connected the server's figures are live") {
   const Freshness f = figures_freshness(true, 100.0, 99.98);
   CHECK(f.live);

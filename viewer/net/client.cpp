@@ -258,6 +258,7 @@ void NetClient::on_snapshot(const wire::Snapshot& s) {
   snap->scene_start = s.scene_start();
   snap->kinetic_energy_per_ball = s.kinetic_energy_per_ball();
   snap->contacts = s.contacts();
+  snap->max_overlap = s.max_overlap();
   snap->tank = s.tank_min() ? TankBounds{to_vec3(*s.tank_min()), to_vec3(*s.tank_max())} : info_->tank;
   snap->ball_count = s.ball_count();
   snap->kinds = kinds_;

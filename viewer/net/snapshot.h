@@ -47,7 +47,8 @@ struct Snapshot {
   std::uint32_t scene_start = 0;         // +1 per scene (re)start: ball ids restart at 0
   float kinetic_energy_per_ball = 0.0f;  // joules
   std::uint32_t contacts = 0;
-  TankBounds tank;  // the scene's: the quantisation bounds (Welcome's when the server did not say)
+  float max_overlap = 0.0f;  // fraction of the smaller radius (Snapshot.max_overlap)
+  TankBounds tank;           // the scene's: the quantisation bounds (Welcome's when the server did not say)
   std::uint32_t ball_count = 0;
   // x, y, z per ball in id order, each 0..65535 over the tank bounds.
   std::vector<std::uint16_t> quantised;
