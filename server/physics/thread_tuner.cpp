@@ -17,8 +17,23 @@ void ThreadTuner::Estimate::add(double sample, double now) {
 ThreadTuner::ThreadTuner(int max_threads)
     : max_threads_(std::max(1, max_threads)), chosen_(max_threads_), threads_(max_threads_) {}
 
-int ThreadTuner::record(double busy_seconds, std::uint64_t steps, double now) {
+int ThreadTuner::record(double busy_seconds, std::uint64_t steps, double now, bool room_for_all) {
   if (max_threads_ <= 1 || steps == 0) return threads_;
+  if (!room_for_all) {
+    if (threads_ == 1) one_.add(busy_seconds / steps, now);
+    chosen_ = threads_ = 1;
+    crowded_ = true;
+    return threads_;
+  }
+  if (crowded_) {  // room again: probe every thread at once
+    crowded_ = false;
+    one_.add(busy_seconds / steps, now);
+    threads_ = max_threads_;
+    last_probe_ = now;
+    probe_busy_ = 0.0;
+    probe_steps_ = 0;
+    return threads_;
+  }
   if (threads_ == chosen_) {
     estimate(chosen_).add(busy_seconds / steps, now);
   } else {

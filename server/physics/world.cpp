@@ -410,7 +410,9 @@ void World::step() {
   advance();
   const Clock::time_point end = Clock::now();
   const auto seconds = [](Clock::duration d) { return std::chrono::duration<double>(d).count(); };
-  set_thread_limit(tuner_->record(seconds(end - start), 1, seconds(end - tuner_epoch_)));
+  const double now = seconds(end - tuner_epoch_);
+  machine_load_.update(now);  // after the step's clock: a reading is not a step's cost
+  set_thread_limit(tuner_->record(seconds(end - start), 1, now, machine_load_.room_for(pool_.threads())));
 }
 
 void World::advance() {

@@ -27,6 +27,7 @@
 #include "common/tank.h"
 #include "server/physics/broadphase.h"
 #include "server/physics/kernels.h"
+#include "server/physics/machine_load.h"
 #include "server/physics/params.h"
 #include "server/physics/spawner.h"
 #include "server/physics/thread_tuner.h"
@@ -115,6 +116,8 @@ class World {
   void set_thread_tuning(bool on);
   // The threads the steps use: the tuner's choice between its probes.
   int stepping_threads() const;
+  // While tuning: the cores other work keeps busy (MachineLoad), below 0 until measured.
+  double others_cores() const { return tuner_ && machine_load_.measured() ? machine_load_.others() : -1.0; }
   std::uint64_t steps_on_one_thread() const { return one_thread_steps_; }
   // Each thread's fraction of the items of every pass since reset_thread_shares().
   std::vector<double> thread_shares() const { return pool_.shares(); }
@@ -186,6 +189,7 @@ class World {
   const Kernels& kernels_;
   WorkerPool pool_;
   std::optional<ThreadTuner> tuner_;
+  MachineLoad machine_load_;
   std::chrono::steady_clock::time_point tuner_epoch_;
   Spawner spawner_;
   NeighbourList list_;

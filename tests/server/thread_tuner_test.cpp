@@ -103,3 +103,21 @@ TEST_CASE("a single-threaded pool is left alone", "[server][threads]") {
   CHECK(tuner.threads() == 1);
   CHECK(r.with_one == r.batches);
 }
+
+TEST_CASE("while other work leaves no room for every thread, one steps unprobed; room back, every thread is probed",
+          "[server][threads]") {
+  ThreadTuner tuner(2);
+  const auto cost = [](int threads) { return threads == 1 ? 200e-6 : 100e-6; };  // every thread cheaper
+  double now = run(tuner, 0.0, 1.0, cost).now;
+  REQUIRE(tuner.chosen() == 2);
+  int with_all = 0;
+  for (double until = now + 2.0; now < until; now += 0.004) {
+    with_all += tuner.threads() != 1;
+    tuner.record(5 * cost(tuner.threads()), 5, now, false);
+  }
+  CHECK(tuner.chosen() == 1);
+  CHECK(with_all <= 1);  // the batch that met the crowd
+  tuner.record(5 * cost(tuner.threads()), 5, now);
+  CHECK(tuner.threads() == 2);  // the first batch with room probes every thread
+  CHECK(time_to_choose(tuner, 2, now, 5.0, cost) <= 0.1);
+}

@@ -1,0 +1,91 @@
+// MachineLoad reads how many cores other work keeps busy from /proc/stat's
+// counters less this process's CPU time, and says whether every thread would
+// find a core of its own.
+
+#include "server/physics/machine_load.h"
+
+#include <catch2/catch.hpp>
+#include <string>
+
+using fishtank::MachineLoad;
+
+namespace {
+
+// /proc/stat's first lines for two CPUs: the "cpu" totals (user nice system
+// idle iowait irq softirq steal guest guest_nice), then each CPU.
+std::string proc_stat(long user, long nice, long system, long idle, long steal) {
+  const std::string totals = std::to_string(user) + " " + std::to_string(nice) + " " + std::to_string(system) + " " +
+                             std::to_string(idle) + " 0 0 0 " + std::to_string(steal) + " 0 0\n";
+  return "cpu  " + totals + "cpu0 " + totals + "cpu1 " + totals + "intr 1 2 3\nctxt 99\n";
+}
+
+MachineLoad::Counters counters(long user, long nice, long system, long idle, long steal, double own) {
+  auto c = MachineLoad::parse_proc_stat(proc_stat(user, nice, system, idle, steal), 100.0);
+  REQUIRE(c);
+  c->own = own;
+  return *c;
+}
+
+}  // namespace
+
+TEST_CASE("/proc/stat's totals are read as busy and total CPU seconds, niced work counted as free",
+          "[server][threads]") {
+  const auto c = MachineLoad::parse_proc_stat(proc_stat(300, 50, 100, 500, 20), 100.0);
+  REQUIRE(c);
+  CHECK(c->busy == Approx(4.2));  // user + system + steal
+  CHECK(c->total == Approx(9.7));
+  CHECK(c->cpus == 2);
+  CHECK_FALSE(MachineLoad::parse_proc_stat("intr 1 2\n", 100.0));
+  CHECK_FALSE(MachineLoad::parse_proc_stat("cpu  12 x\n", 100.0));
+}
+
+TEST_CASE("the others' cores are the machine's busy time less this process's", "[server][threads]") {
+  // 0.2 s on two CPUs (40 ticks): 30 ticks busy, of which this process used 0.1 s.
+  const auto a = counters(1000, 0, 0, 1000, 0, 5.0);
+  const auto b = counters(1030, 0, 0, 1010, 0, 5.1);
+  CHECK(MachineLoad::others_between(a, b) == Approx(1.0));  // (0.3 - 0.1) / 0.4 of 2 CPUs
+  // The hypervisor's steal counts as others'; this process's own time never makes them negative.
+  CHECK(MachineLoad::others_between(a, counters(1000, 0, 0, 1020, 20, 5.0)) == Approx(1.0));
+  CHECK(MachineLoad::others_between(a, counters(1010, 0, 0, 1030, 0, 6.0)) == 0.0);
+  CHECK(MachineLoad::others_between(a, a) == 0.0);
+}
+
+TEST_CASE("every thread has room until other work takes more than half a core of what they need", "[server][threads]") {
+  MachineLoad load;
+  CHECK(load.room_for(2));  // nothing measured yet
+  double now = 0.0, own = 0.0;
+  long busy = 0, idle = 0;
+  // Each reading 0.1 s apart on 2 CPUs (20 ticks), `others` of them busy with other work.
+  const auto read = [&](long others) {
+    busy += others, idle += 20 - others, now += 0.1;
+    load.add_reading(counters(busy, 0, 0, idle, 0, own), now);
+  };
+  read(0);
+  read(0);
+  REQUIRE(load.measured());
+  CHECK(load.room_for(2));
+  read(20);  // both cores taken by others: after one reading the smoothed figure is 1 core
+  CHECK(load.others() == Approx(1.0));
+  CHECK_FALSE(load.room_for(2));
+  CHECK(load.room_for(1));  // one core is left to one thread
+  read(20);
+  read(20);
+  CHECK_FALSE(load.room_for(1));
+  // Back to idle: every thread has room again within three readings.
+  read(0);
+  read(0);
+  read(0);
+  CHECK(load.room_for(2));
+}
+
+TEST_CASE("this machine's counters can be read", "[server][threads]") {
+  const auto c = MachineLoad::read();
+  if (!c) {
+    WARN("SKIPPED: /proc/stat cannot be read here");
+    return;
+  }
+  CHECK(c->cpus >= 1);
+  CHECK(c->total > 0.0);
+  CHECK(c->busy <= c->total);
+  CHECK(c->own > 0.0);
+}
