@@ -18,7 +18,7 @@ class MachineLoad {
  public:
   // Seconds between readings, and the weight a new reading gets: the figure
   // follows a change of load within a few readings.
-  static constexpr double kInterval = 0.1;
+  static constexpr double kInterval = 0.05;
   static constexpr double kWeight = 0.5;
 
   // Cumulative CPU seconds: the machine's busy (niced work left out) and total
