@@ -84,13 +84,13 @@ int run_bench(const fishtank::ServerOptions& o) {
 
 // "2 threads", or "3 threads on 2 cores: oversubscribed": more threads than
 // cores is allowed, but then they take turns and the figures should say so.
-// Other work of half a core or more, which can keep the steps on one thread, is named too.
-std::string threads_text(int threads, int cores, double others_cores = -1.0) {
+// Work in other sessions of half a core or more, which can keep the steps on one thread, is named too.
+std::string threads_text(int threads, int cores, double crowding_cores = -1.0) {
   std::string text = std::to_string(threads) + (threads == 1 ? " thread" : " threads");
   if (threads > cores) text += " on " + std::to_string(cores) + (cores == 1 ? " core" : " cores") + ": oversubscribed";
-  if (others_cores >= 0.5) {
+  if (crowding_cores >= 0.5) {
     char others[64];
-    std::snprintf(others, sizeof others, " (other work keeps %.1f cores busy)", others_cores);
+    std::snprintf(others, sizeof others, " (other sessions keep %.1f cores busy)", crowding_cores);
     text += others;
   }
   return text;
@@ -180,11 +180,11 @@ int run_server(const fishtank::ServerOptions& o) {
   };
   loop.on_status = [&network, &control, &scene, cores](const fishtank::World& w, const fishtank::LoopStatus& s) {
     const std::string warning = w.overlap_warning();
-    std::fprintf(stderr,
-                 "t = %7.1f s  balls %5u (+%u queued)  %6.0f steps/s  load %5.1f %% on %s  %s  scene %s%s%s%s\n",
-                 w.time(), w.ball_count(), w.pending(), s.steps_per_s, 100.0 * s.load,
-                 threads_text(s.threads, cores, s.others_cores).c_str(), network.status().c_str(), scene.name().c_str(),
-                 pace_text(s, control).c_str(), warning.empty() ? "" : "  WARNING: ", warning.c_str());
+    std::fprintf(
+        stderr, "t = %7.1f s  balls %5u (+%u queued)  %6.0f steps/s  load %5.1f %% on %s  %s  scene %s%s%s%s\n",
+        w.time(), w.ball_count(), w.pending(), s.steps_per_s, 100.0 * s.load,
+        threads_text(s.threads, cores, s.crowding_cores).c_str(), network.status().c_str(), scene.name().c_str(),
+        pace_text(s, control).c_str(), warning.empty() ? "" : "  WARNING: ", warning.c_str());
   };
   fishtank::run_realtime(world, loop, g_stop);
   std::cerr << "fishtank-server: stopped after " << world.steps() << " steps, " << world.ball_count() << " balls\n";

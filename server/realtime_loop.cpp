@@ -61,7 +61,7 @@ void run_realtime(World& world, const LoopOptions& options, const std::atomic<bo
     window_busy += busy;
     window_steps += batch_steps;
     status.threads = world.stepping_threads();
-    status.others_cores = world.others_cores();
+    status.crowding_cores = world.crowding_cores();
 
     const double window = seconds_between(window_start, busy_end);
     if (window >= options.status_interval) {

@@ -15,7 +15,7 @@ namespace fishtank {
 struct LoopStatus {
   double steps_per_s = 0.0;
   int threads = 1;                  // worker threads the steps use now (see ThreadTuner)
-  double others_cores = -1.0;       // cores other work keeps busy (MachineLoad); below 0 unknown
+  double crowding_cores = -1.0;     // cores work in other sessions keeps busy; below 0 unknown
   double load = 0.0;                // 0..1: time spent stepping / wall time
   std::uint64_t dropped_steps = 0;  // steps skipped because the machine fell behind, in the last interval
   // Simulated seconds per wall second over the last interval: below 1 the

@@ -61,11 +61,12 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   // The thread tuner's choice: the fraction of the timed steps taken on one thread.
   j["one_thread_step_fraction"] =
       double(world.steps_on_one_thread() - one_thread_before) / std::max<std::uint64_t>(1, spec.steps);
-  // Cores other work kept busy at the end (MachineLoad), which keeps the steps on one thread; null untuned.
-  if (const double others = world.others_cores(); others >= 0.0)
-    j["others_cores"] = others;
+  // Cores work in other sessions kept busy at the end (MachineLoad), which keeps the steps on one thread;
+  // null untuned.
+  if (const double others = world.crowding_cores(); others >= 0.0)
+    j["crowding_cores"] = others;
   else
-    j["others_cores"] = nullptr;
+    j["crowding_cores"] = nullptr;
   j["balls"] = world.ball_count();
   j["steps"] = spec.steps;
   j["seconds"] = seconds;

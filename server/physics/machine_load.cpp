@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <charconv>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -16,6 +17,27 @@ namespace {
 enum Field { kUser, kNice, kSystem, kIdle, kIowait, kIrq, kSoftirq, kSteal, kFields };
 
 bool starts_with(std::string_view text, std::string_view prefix) { return text.substr(0, prefix.size()) == prefix; }
+
+std::string read_file(const std::string& path) {
+  std::ifstream file(path);
+  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+}
+
+double ticks_per_second() {
+  const long ticks = sysconf(_SC_CLK_TCK);
+  return ticks > 0 ? double(ticks) : 100.0;
+}
+
+// The next space-separated number of `text`, consumed.
+template <class Number = unsigned long long>
+std::optional<Number> next_number(std::string_view& text) {
+  text.remove_prefix(std::min(text.find_first_not_of(' '), text.size()));
+  Number value = 0;
+  const auto [next, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (error != std::errc()) return std::nullopt;
+  text.remove_prefix(static_cast<std::size_t>(next - text.data()));
+  return value;
+}
 }  // namespace
 
 std::optional<MachineLoad::Counters> MachineLoad::parse_proc_stat(std::string_view text, double ticks_per_second) {
@@ -33,15 +55,12 @@ std::optional<MachineLoad::Counters> MachineLoad::parse_proc_stat(std::string_vi
     double field[kFields] = {};
     line.remove_prefix(3);
     for (int f = 0; f < kFields; ++f) {
-      line.remove_prefix(std::min(line.find_first_not_of(' '), line.size()));
-      unsigned long long ticks = 0;
-      const auto [next, error] = std::from_chars(line.data(), line.data() + line.size(), ticks);
-      if (error != std::errc()) {
+      const std::optional<unsigned long long> ticks = next_number(line);
+      if (!ticks) {
         if (f <= kIdle) return std::nullopt;  // kernels before 2.6.11 give fewer fields: the rest stay 0
         break;
       }
-      field[f] = static_cast<double>(ticks) / ticks_per_second;
-      line.remove_prefix(static_cast<std::size_t>(next - line.data()));
+      field[f] = static_cast<double>(*ticks) / ticks_per_second;
     }
     Counters c;
     c.busy = field[kUser] + field[kSystem] + field[kIrq] + field[kSoftirq] + field[kSteal];
@@ -53,10 +72,7 @@ std::optional<MachineLoad::Counters> MachineLoad::parse_proc_stat(std::string_vi
 }
 
 std::optional<MachineLoad::Counters> MachineLoad::read() {
-  std::ifstream file("/proc/stat");
-  const std::string text{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
-  const long ticks = sysconf(_SC_CLK_TCK);
-  std::optional<Counters> counters = parse_proc_stat(text, ticks > 0 ? double(ticks) : 100.0);
+  std::optional<Counters> counters = parse_proc_stat(read_file("/proc/stat"), ticks_per_second());
   timespec own{};
   if (!counters || clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &own) != 0) return std::nullopt;
   counters->own = double(own.tv_sec) + 1e-9 * double(own.tv_nsec);
@@ -70,28 +86,95 @@ double MachineLoad::others_between(const Counters& earlier, const Counters& late
   return std::clamp(others / total, 0.0, 1.0) * later.cpus;
 }
 
-void MachineLoad::update(double now) {
-  if (unreadable_ || (last_ && now - last_at_ < kInterval)) return;
-  if (const std::optional<Counters> counters = read())
-    add_reading(*counters, now);
-  else
-    unreadable_ = true;  // not Linux, or no /proc: every thread keeps its room
+std::optional<MachineLoad::Process> MachineLoad::parse_pid_stat(std::string_view text, double ticks_per_second) {
+  // "pid (comm) state ppid pgrp session ... utime stime ...": comm may hold spaces and parentheses.
+  const std::size_t comm_end = text.rfind(')');
+  if (comm_end == std::string_view::npos) return std::nullopt;
+  text.remove_prefix(comm_end + 1);
+  text.remove_prefix(std::min(text.find_first_not_of(' '), text.size()));
+  text.remove_prefix(std::min(text.find(' '), text.size()));  // the state letter
+  long long field[12] = {};  // ppid pgrp session tty_nr tpgid (-1 without a terminal) ... utime stime
+  for (long long& f : field) {
+    const std::optional<long long> value = next_number<long long>(text);
+    if (!value) return std::nullopt;
+    f = *value;
+  }
+  return Process{static_cast<int>(field[2]), static_cast<double>(field[10] + field[11]) / ticks_per_second};
 }
 
-void MachineLoad::add_reading(const Counters& counters, double now) {
+MachineLoad::MachineLoad(bool sessions_share) : sessions_share_(sessions_share) {}
+
+bool MachineLoad::autogroup_enabled() {
+  return starts_with(read_file("/proc/sys/kernel/sched_autogroup_enabled"), "1");
+}
+
+std::optional<double> MachineLoad::session_cpu_since_last() {
+  const int self = static_cast<int>(getpid()), session = static_cast<int>(getsid(0));
+  const double ticks = ticks_per_second();
+  std::unordered_map<int, double> now;
+  double used = 0.0;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc", error)) {
+    const std::string name = entry.path().filename().string();
+    int pid = 0;
+    const auto [end, bad] = std::from_chars(name.data(), name.data() + name.size(), pid);
+    if (bad != std::errc() || end != name.data() + name.size() || pid == self) continue;
+    const std::optional<Process> p = parse_pid_stat(read_file(entry.path().string() + "/stat"), ticks);
+    if (!p || p->session != session) continue;
+    now[pid] = p->cpu;
+    if (const auto before = session_cpu_.find(pid); before != session_cpu_.end())
+      used += std::max(0.0, p->cpu - before->second);
+  }
+  if (error) return std::nullopt;
+  const bool had_baseline = looked_up_last_;
+  session_cpu_ = std::move(now);
+  looked_up_last_ = true;
+  return had_baseline ? std::optional<double>(used) : std::nullopt;
+}
+
+void MachineLoad::update(double now) {
+  if (unreadable_ || (last_ && now - last_at_ < kInterval)) return;
+  const std::optional<Counters> counters = read();
+  if (!counters) {
+    unreadable_ = true;  // not Linux, or no /proc: every thread keeps its room
+    return;
+  }
+  // Sessions are looked up only while others are busy: it reads a file per process.
+  std::optional<double> session_cpu;
+  if (sessions_share_ && measured_ && others_ >= kLookUpSessions) {
+    session_cpu = session_cpu_since_last();
+  } else {
+    looked_up_last_ = false;
+    session_others_ = 0.0, session_measured_ = false;
+  }
+  add_reading(*counters, session_cpu, now);
+}
+
+void MachineLoad::add_reading(const Counters& counters, std::optional<double> session_cpu, double now) {
   if (last_) {
     const double others = others_between(*last_, counters);
     others_ = measured_ ? others_ + kWeight * (others - others_) : others;
     measured_ = true;
+    const double total = counters.total - last_->total;
+    if (session_cpu && total > 0.0) {
+      const double session = std::clamp(*session_cpu / total, 0.0, 1.0) * counters.cpus;
+      session_others_ = session_measured_ ? session_others_ + kWeight * (session - session_others_) : session;
+      session_measured_ = true;
+    }
   }
   last_ = counters;
   last_at_ = now;
 }
 
+double MachineLoad::crowding() const {
+  if (!sessions_share_) return 0.0;  // every thread is shared alike: more threads, more share
+  return std::max(0.0, others_ - session_others_);
+}
+
 bool MachineLoad::room_for(int threads) const {
   if (!measured_) return true;
   const int wanted = std::min(threads, cpus());
-  return cpus() - others_ >= wanted - 0.5;
+  return cpus() - crowding() >= wanted - 0.5;
 }
 
 }  // namespace fishtank

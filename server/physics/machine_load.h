@@ -3,14 +3,17 @@
 // counters: the CPU time /proc/stat counts as busy on every CPU (the
 // hypervisor's steal included) less this process's own.
 //
-// A pass waits for its slowest thread, so when other work leaves no core free
-// for each thread, stepping on one is faster than on all: the kernel gives a
-// process in its own session the same share whatever its thread count
-// (autogroup), and a worker preempted inside a chunk holds up the pass for a
-// time slice. Niced work is left out: it yields to the simulation.
+// Where the kernel shares CPU time between sessions (autogroup, Debian's
+// default), work in other sessions leaves this process the same share however
+// many threads it runs, and a worker preempted inside a chunk holds up its
+// pass: one thread steps faster than all. Work in this process's own session
+// is shared per thread, so more threads do win a larger share; it is read from
+// /proc/<pid>/stat while others are busy, and does not crowd. Niced work is
+// left out: it yields to the simulation.
 
 #include <optional>
 #include <string_view>
+#include <unordered_map>
 
 namespace fishtank {
 
@@ -20,6 +23,8 @@ class MachineLoad {
   // follows a change of load within a few readings.
   static constexpr double kInterval = 0.05;
   static constexpr double kWeight = 0.5;
+  // Below this many cores of other work, its session is not looked up.
+  static constexpr double kLookUpSessions = 0.5;
 
   // Cumulative CPU seconds: the machine's busy (niced work left out) and total
   // over all its CPUs, and this process's own.
@@ -34,22 +39,43 @@ class MachineLoad {
   // Cores the others kept busy between two readings: their share of the CPU time times the CPUs.
   static double others_between(const Counters& earlier, const Counters& later);
 
+  // A process's session and CPU seconds, from the text of its /proc/<pid>/stat.
+  struct Process {
+    int session = 0;
+    double cpu = 0.0;
+  };
+  static std::optional<Process> parse_pid_stat(std::string_view text, double ticks_per_second);
+
+  // Whether the kernel shares CPU time between sessions (/proc/sys/kernel/sched_autogroup_enabled).
+  explicit MachineLoad(bool sessions_share = autogroup_enabled());
+  static bool autogroup_enabled();
+
   // Takes a reading if kInterval has passed since the last one (`now` in seconds).
   void update(double now);
-  void add_reading(const Counters& counters, double now);
+  // A reading: the machine's counters, and the CPU seconds this session's
+  // other processes used since the last reading (nothing where not looked up).
+  void add_reading(const Counters& counters, std::optional<double> session_cpu, double now);
   bool measured() const { return measured_; }
   // The others' cores, smoothed over the last few readings; 0 until measured.
   double others() const { return others_; }
+  // Of those, the cores of work in other sessions: what crowds this process.
+  double crowding() const;
   int cpus() const { return last_ ? last_->cpus : 0; }
-  // Whether `threads` threads each find a core the others leave (nearly) free.
+  // Whether `threads` threads each find a core that work in other sessions leaves (nearly) free.
   bool room_for(int threads) const;
 
  private:
+  // CPU seconds this session's other processes used since the last call (those seen both times).
+  std::optional<double> session_cpu_since_last();
+
+  bool sessions_share_;
   std::optional<Counters> last_;
   double last_at_ = 0.0;
-  double others_ = 0.0;
-  bool measured_ = false;
+  double others_ = 0.0, session_others_ = 0.0;
+  bool measured_ = false, session_measured_ = false;
   bool unreadable_ = false;
+  std::unordered_map<int, double> session_cpu_;  // by pid, at the last look-up
+  bool looked_up_last_ = false;
 };
 
 }  // namespace fishtank

@@ -116,8 +116,8 @@ class World {
   void set_thread_tuning(bool on);
   // The threads the steps use: the tuner's choice between its probes.
   int stepping_threads() const;
-  // While tuning: the cores other work keeps busy (MachineLoad), below 0 until measured.
-  double others_cores() const { return tuner_ && machine_load_.measured() ? machine_load_.others() : -1.0; }
+  // While tuning: the cores work in other sessions keeps busy (MachineLoad::crowding), below 0 until measured.
+  double crowding_cores() const { return tuner_ && machine_load_.measured() ? machine_load_.crowding() : -1.0; }
   std::uint64_t steps_on_one_thread() const { return one_thread_steps_; }
   // Each thread's fraction of the items of every pass since reset_thread_shares().
   std::vector<double> thread_shares() const { return pool_.shares(); }

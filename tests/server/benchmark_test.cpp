@@ -50,7 +50,7 @@ TEST_CASE("the benchmark report holds every figure asked for, consistent with th
   const nlohmann::json j = time_steps(world, spec, settled);
   for (const char* key :
        {"variant", "simd", "threads", "balls", "steps", "seconds", "steps_per_s", "ball_steps_per_s", "dt", "k",
-        "max_overlap", "pile_top", "phase_seconds", "settle", "peak_rss_mib", "others_cores"}) {
+        "max_overlap", "pile_top", "phase_seconds", "settle", "peak_rss_mib", "crowding_cores"}) {
     INFO(key);
     CHECK(j.contains(key));
   }

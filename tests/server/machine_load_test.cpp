@@ -50,15 +50,16 @@ TEST_CASE("the others' cores are the machine's busy time less this process's", "
   CHECK(MachineLoad::others_between(a, a) == 0.0);
 }
 
-TEST_CASE("every thread has room until other work takes more than half a core of what they need", "[server][threads]") {
-  MachineLoad load;
+TEST_CASE("every thread has room until work in other sessions takes more than half a core of what they need",
+          "[server][threads]") {
+  MachineLoad load(true);
   CHECK(load.room_for(2));  // nothing measured yet
   double now = 0.0, own = 0.0;
   long busy = 0, idle = 0;
   // Each reading 0.1 s apart on 2 CPUs (20 ticks), `others` of them busy with other work.
   const auto read = [&](long others) {
     busy += others, idle += 20 - others, now += 0.1;
-    load.add_reading(counters(busy, 0, 0, idle, 0, own), now);
+    load.add_reading(counters(busy, 0, 0, idle, 0, own), std::nullopt, now);
   };
   read(0);
   read(0);
@@ -76,6 +77,40 @@ TEST_CASE("every thread has room until other work takes more than half a core of
   read(0);
   read(0);
   CHECK(load.room_for(2));
+}
+
+TEST_CASE("a process's session and CPU time are read from its /proc/<pid>/stat, whatever its name",
+          "[server][threads]") {
+  const auto p = MachineLoad::parse_pid_stat(
+      "1234 (a (b) c) R 1 1234 1200 0 -1 4194304 100 0 0 0 250 50 0 0 20 0 1 0 99 1000 10\n", 100.0);
+  REQUIRE(p);
+  CHECK(p->session == 1200);
+  CHECK(p->cpu == Approx(3.0));  // (utime 250 + stime 50) / 100
+  CHECK_FALSE(MachineLoad::parse_pid_stat("1234 (cut short) R 1 2", 100.0));
+  CHECK_FALSE(MachineLoad::parse_pid_stat("no name here", 100.0));
+}
+
+TEST_CASE("work in this process's own session, or on a kernel that shares time per thread, leaves every thread room",
+          "[server][threads]") {
+  // Both cores busy with others for a second (20 ticks per 0.1 s reading on 2 CPUs).
+  const auto run = [](MachineLoad& load, double session_share) {
+    long busy = 0, idle = 0;
+    for (int r = 1; r <= 10; ++r) {
+      busy += 20;
+      load.add_reading(counters(busy, 0, 0, idle, 0, 0.0),
+                       r > 1 ? std::optional<double>(0.2 * session_share) : std::nullopt, 0.1 * r);
+    }
+  };
+  MachineLoad same_session(true), other_sessions(true), per_thread(false);
+  run(same_session, 1.0);
+  run(other_sessions, 0.0);
+  run(per_thread, 0.0);
+  CHECK(same_session.others() == Approx(2.0).margin(0.01));
+  CHECK(same_session.crowding() == Approx(0.0).margin(0.01));
+  CHECK(same_session.room_for(2));
+  CHECK(other_sessions.crowding() == Approx(2.0).margin(0.01));
+  CHECK_FALSE(other_sessions.room_for(2));
+  CHECK(per_thread.room_for(2));
 }
 
 TEST_CASE("this machine's counters can be read", "[server][threads]") {
