@@ -126,10 +126,16 @@ std::optional<double> MachineLoad::session_cpu_since_last() {
       used += std::max(0.0, p->cpu - before->second);
   }
   if (error) return std::nullopt;
-  const bool had_baseline = looked_up_last_;
+  const bool had_baseline = looked_up_at_.has_value();
   session_cpu_ = std::move(now);
-  looked_up_last_ = true;
   return had_baseline ? std::optional<double>(used) : std::nullopt;
+}
+
+void MachineLoad::look_up_session(double now) {
+  const std::optional<double> since = looked_up_at_;
+  const std::optional<double> used = session_cpu_since_last();
+  looked_up_at_ = now;
+  if (used && since && now > *since) add_session_reading(*used / (now - *since));
 }
 
 void MachineLoad::update(double now) {
@@ -139,31 +145,28 @@ void MachineLoad::update(double now) {
     unreadable_ = true;  // not Linux, or no /proc: every thread keeps its room
     return;
   }
-  // Sessions are looked up only while others are busy: it reads a file per process.
-  std::optional<double> session_cpu;
-  if (sessions_share_ && measured_ && others_ >= kLookUpSessions) {
-    session_cpu = session_cpu_since_last();
-  } else {
-    looked_up_last_ = false;
+  add_reading(*counters, now);
+  if (!sessions_share_ || others_ < kLookUpSessions) {
+    looked_up_at_.reset();
     session_others_ = 0.0, session_measured_ = false;
+  } else if (!looked_up_at_ || now - *looked_up_at_ >= kSessionInterval) {
+    look_up_session(now);
   }
-  add_reading(*counters, session_cpu, now);
 }
 
-void MachineLoad::add_reading(const Counters& counters, std::optional<double> session_cpu, double now) {
+void MachineLoad::add_reading(const Counters& counters, double now) {
   if (last_) {
     const double others = others_between(*last_, counters);
     others_ = measured_ ? others_ + kWeight * (others - others_) : others;
     measured_ = true;
-    const double total = counters.total - last_->total;
-    if (session_cpu && total > 0.0) {
-      const double session = std::clamp(*session_cpu / total, 0.0, 1.0) * counters.cpus;
-      session_others_ = session_measured_ ? session_others_ + kWeight * (session - session_others_) : session;
-      session_measured_ = true;
-    }
   }
   last_ = counters;
   last_at_ = now;
+}
+
+void MachineLoad::add_session_reading(double cores) {
+  session_others_ = session_measured_ ? session_others_ + kWeight * (cores - session_others_) : cores;
+  session_measured_ = true;
 }
 
 double MachineLoad::crowding() const {

@@ -23,8 +23,10 @@ class MachineLoad {
   // follows a change of load within a few readings.
   static constexpr double kInterval = 0.05;
   static constexpr double kWeight = 0.5;
-  // Below this many cores of other work, its session is not looked up.
+  // Below this many cores of other work, its session is not looked up; when
+  // it is, every kSessionInterval (a file read per process).
   static constexpr double kLookUpSessions = 0.5;
+  static constexpr double kSessionInterval = 0.25;
 
   // Cumulative CPU seconds: the machine's busy (niced work left out) and total
   // over all its CPUs, and this process's own.
@@ -52,9 +54,10 @@ class MachineLoad {
 
   // Takes a reading if kInterval has passed since the last one (`now` in seconds).
   void update(double now);
-  // A reading: the machine's counters, and the CPU seconds this session's
-  // other processes used since the last reading (nothing where not looked up).
-  void add_reading(const Counters& counters, std::optional<double> session_cpu, double now);
+  // A reading of the machine's counters.
+  void add_reading(const Counters& counters, double now);
+  // A look-up: the cores this session's other processes kept busy since the last one.
+  void add_session_reading(double cores);
   bool measured() const { return measured_; }
   // The others' cores, smoothed over the last few readings; 0 until measured.
   double others() const { return others_; }
@@ -67,6 +70,7 @@ class MachineLoad {
  private:
   // CPU seconds this session's other processes used since the last call (those seen both times).
   std::optional<double> session_cpu_since_last();
+  void look_up_session(double now);
 
   bool sessions_share_;
   std::optional<Counters> last_;
@@ -75,7 +79,7 @@ class MachineLoad {
   bool measured_ = false, session_measured_ = false;
   bool unreadable_ = false;
   std::unordered_map<int, double> session_cpu_;  // by pid, at the last look-up
-  bool looked_up_last_ = false;
+  std::optional<double> looked_up_at_;           // when, while look-ups follow one another
 };
 
 }  // namespace fishtank

@@ -59,7 +59,7 @@ TEST_CASE("every thread has room until work in other sessions takes more than ha
   // Each reading 0.1 s apart on 2 CPUs (20 ticks), `others` of them busy with other work.
   const auto read = [&](long others) {
     busy += others, idle += 20 - others, now += 0.1;
-    load.add_reading(counters(busy, 0, 0, idle, 0, own), std::nullopt, now);
+    load.add_reading(counters(busy, 0, 0, idle, 0, own), now);
   };
   read(0);
   read(0);
@@ -93,16 +93,16 @@ TEST_CASE("a process's session and CPU time are read from its /proc/<pid>/stat, 
 TEST_CASE("work in this process's own session, or on a kernel that shares time per thread, leaves every thread room",
           "[server][threads]") {
   // Both cores busy with others for a second (20 ticks per 0.1 s reading on 2 CPUs).
-  const auto run = [](MachineLoad& load, double session_share) {
+  const auto run = [](MachineLoad& load, double session_cores) {
     long busy = 0, idle = 0;
     for (int r = 1; r <= 10; ++r) {
       busy += 20;
-      load.add_reading(counters(busy, 0, 0, idle, 0, 0.0),
-                       r > 1 ? std::optional<double>(0.2 * session_share) : std::nullopt, 0.1 * r);
+      load.add_reading(counters(busy, 0, 0, idle, 0, 0.0), 0.1 * r);
+      if (r % 3 == 0) load.add_session_reading(session_cores);  // looked up less often
     }
   };
   MachineLoad same_session(true), other_sessions(true), per_thread(false);
-  run(same_session, 1.0);
+  run(same_session, 2.0);
   run(other_sessions, 0.0);
   run(per_thread, 0.0);
   CHECK(same_session.others() == Approx(2.0).margin(0.01));
