@@ -1,5 +1,7 @@
 #include "server/net/physics_link.h"
 
+#include <spdlog/spdlog.h>
+
 #include <string>
 
 namespace fishtank::net {
@@ -97,6 +99,7 @@ void PhysicsLink::apply(World& world, const Command& command) {
                    // Asked-for steps belonged to the old start; a pause holds the new one still.
                    control_.steps_to_run = 0;
                    std::string refusal = scene_.start(world, reset.scene, reset.seed);
+                   if (!scene_.limit_note().empty()) spdlog::warn("{}", scene_.limit_note());
                    const Clock::time_point end = Clock::now();
                    next_reset_ = end + kResetSpacing * (end - start);
                    if (!refusal.empty())

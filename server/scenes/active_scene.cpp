@@ -16,8 +16,11 @@ std::string ActiveScene::start(World& world, const std::optional<std::string>& s
   if (seed) choice_.seed = *seed;
   const SceneSpec s = spec();
   world.restart(scene_tank(s), s.seed);
-  // Refused by a scene whose tank holds fewer: its capacity is then the limit.
-  if (choice_.max_balls > 0) world.set_max_balls(choice_.max_balls);
+  // Refused by a scene whose tank holds fewer: its capacity is then the limit, and the note says so.
+  limit_note_.clear();
+  if (choice_.max_balls > 0)
+    if (const std::string refusal = world.set_max_balls(choice_.max_balls); !refusal.empty())
+      limit_note_ = "scene " + choice_.name + ": --max-balls: " + refusal + "; the tank's capacity is the limit";
   std::string refusal = populate(world, s);
   world.respawn_players();
   ++starts_;

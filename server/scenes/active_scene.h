@@ -31,6 +31,8 @@ class ActiveScene {
   std::string start(World& world, const std::optional<std::string>& scene = std::nullopt,
                     std::optional<std::uint64_t> seed = std::nullopt);
 
+  // After a start: "" or why --max-balls could not hold in this scene's tank (its capacity is then the limit).
+  const std::string& limit_note() const { return limit_note_; }
   const std::string& name() const { return choice_.name; }
   std::uint64_t seed() const { return choice_.seed; }
   std::uint32_t start_count() const { return starts_; }
@@ -40,6 +42,7 @@ class ActiveScene {
 
   SceneChoice choice_;
   std::uint32_t starts_ = 0;
+  std::string limit_note_;
 };
 
 }  // namespace fishtank

@@ -147,3 +147,24 @@ TEST_CASE("switching scene changes the tank, restarts ball ids at 0 and keeps ev
   run_steps(world, 500);
   CHECK(world.escaped_or_invalid() == 0);
 }
+
+TEST_CASE("a scene whose tank holds fewer balls than --max-balls says so, and its capacity is the limit", "[scenes]") {
+  SceneChoice choice;
+  choice.balls = 300;
+  choice.max_balls = 6000;  // the tank holds 6111
+  ActiveScene scene(choice);
+  PhysicsParams params;
+  params.tank = scene.first_tank();
+  World world(params, kSseKernels, 1, 1);
+  REQUIRE(scene.start(world).empty());
+  CHECK(scene.limit_note().empty());
+  CHECK(world.max_balls() == 6000);
+  REQUIRE(scene.start(world, std::string("wide")).empty());  // 300 balls: a narrow tank
+  REQUIRE(world.capacity() < 6000);
+  CHECK(world.max_balls() == world.capacity());
+  CHECK_THAT(scene.limit_note(),
+             Catch::Contains("wide") && Catch::Contains("--max-balls") && Catch::Contains("asked for 6000"));
+  REQUIRE(scene.start(world, std::string("tank")).empty());
+  CHECK(scene.limit_note().empty());
+  CHECK(world.max_balls() == 6000);
+}
