@@ -1,13 +1,12 @@
 #include "server/physics/machine_load.h"
 
+#include <dirent.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <charconv>
 #include <ctime>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 
 namespace fishtank {
@@ -18,9 +17,16 @@ enum Field { kUser, kNice, kSystem, kIdle, kIowait, kIrq, kSoftirq, kSteal, kFie
 
 bool starts_with(std::string_view text, std::string_view prefix) { return text.substr(0, prefix.size()) == prefix; }
 
+// A small /proc file, or "" where it cannot be opened (no descriptor left, the process gone). Plain
+// POSIX reads: /proc files are generated as they are read, and this runs in the physics thread.
 std::string read_file(const std::string& path) {
-  std::ifstream file(path);
-  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+  std::string text;
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return text;
+  char buffer[4096];
+  for (ssize_t got; (got = ::read(fd, buffer, sizeof buffer)) > 0;) text.append(buffer, static_cast<std::size_t>(got));
+  ::close(fd);
+  return text;
 }
 
 double ticks_per_second() {
@@ -113,28 +119,32 @@ std::optional<double> MachineLoad::session_cpu_since_last() {
   const double ticks = ticks_per_second();
   std::unordered_map<int, double> now;
   double used = 0.0;
-  std::error_code error;
-  for (const auto& entry : std::filesystem::directory_iterator("/proc", error)) {
-    const std::string name = entry.path().filename().string();
+  DIR* const proc = opendir("/proc");
+  if (!proc) {  // no descriptor left: the next look-up starts afresh
+    session_cpu_.clear();
+    looked_up_at_.reset();
+    return std::nullopt;
+  }
+  while (const dirent* entry = readdir(proc)) {
+    const std::string_view name = entry->d_name;
     int pid = 0;
     const auto [end, bad] = std::from_chars(name.data(), name.data() + name.size(), pid);
     if (bad != std::errc() || end != name.data() + name.size() || pid == self) continue;
-    const std::optional<Process> p = parse_pid_stat(read_file(entry.path().string() + "/stat"), ticks);
+    const std::optional<Process> p = parse_pid_stat(read_file("/proc/" + std::string(name) + "/stat"), ticks);
     if (!p || p->session != session) continue;
     now[pid] = p->cpu;
     if (const auto before = session_cpu_.find(pid); before != session_cpu_.end())
       used += std::max(0.0, p->cpu - before->second);
   }
-  if (error) return std::nullopt;
-  const bool had_baseline = looked_up_at_.has_value();
+  closedir(proc);
   session_cpu_ = std::move(now);
-  return had_baseline ? std::optional<double>(used) : std::nullopt;
+  return used;
 }
 
 void MachineLoad::look_up_session(double now) {
   const std::optional<double> since = looked_up_at_;
-  const std::optional<double> used = session_cpu_since_last();
   looked_up_at_ = now;
+  const std::optional<double> used = session_cpu_since_last();
   if (used && since && now > *since) add_session_reading(*used / (now - *since));
 }
 
@@ -149,7 +159,8 @@ void MachineLoad::update(double now) {
   if (!sessions_share_ || others_ < kLookUpSessions) {
     looked_up_at_.reset();
     session_others_ = 0.0, session_measured_ = false;
-  } else if (!looked_up_at_ || now - *looked_up_at_ >= kSessionInterval) {
+  } else if (!session_measured_ || !looked_up_at_ ||
+             now - *looked_up_at_ >= kSessionInterval) {  // at once until measured
     look_up_session(now);
   }
 }
@@ -172,6 +183,11 @@ void MachineLoad::add_session_reading(double cores) {
 double MachineLoad::crowding() const {
   if (!sessions_share_) return 0.0;  // every thread is shared alike: more threads, more share
   return std::max(0.0, others_ - session_others_);
+}
+
+bool MachineLoad::shared_per_thread() const {
+  if (!measured_) return false;
+  return (sessions_share_ ? (session_measured_ ? session_others_ : 0.0) : others_) >= kLookUpSessions;
 }
 
 bool MachineLoad::room_for(int threads) const {

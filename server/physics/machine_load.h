@@ -8,8 +8,8 @@
 // many threads it runs, and a worker preempted inside a chunk holds up its
 // pass: one thread steps faster than all. Work in this process's own session
 // is shared per thread, so more threads do win a larger share; it is read from
-// /proc/<pid>/stat while others are busy, and does not crowd. Niced work is
-// left out: it yields to the simulation.
+// /proc/<pid>/stat while others are busy. Niced work is left out: it yields to
+// the simulation.
 
 #include <optional>
 #include <string_view>
@@ -24,7 +24,8 @@ class MachineLoad {
   static constexpr double kInterval = 0.05;
   static constexpr double kWeight = 0.5;
   // Below this many cores of other work, its session is not looked up; when
-  // it is, every kSessionInterval (a file read per process).
+  // it is, at each reading until measured, then every kSessionInterval (a file
+  // read per process).
   static constexpr double kLookUpSessions = 0.5;
   static constexpr double kSessionInterval = 0.25;
 
@@ -66,6 +67,10 @@ class MachineLoad {
   int cpus() const { return last_ ? last_->cpus : 0; }
   // Whether `threads` threads each find a core that work in other sessions leaves (nearly) free.
   bool room_for(int threads) const;
+  // Whether other work that the kernel shares the cores with per thread (this
+  // session's, or any where sessions do not share) keeps half a core or more
+  // busy: more threads then win a larger share.
+  bool shared_per_thread() const;
 
  private:
   // CPU seconds this session's other processes used since the last call (those seen both times).

@@ -17,18 +17,19 @@ void ThreadTuner::Estimate::add(double sample, double now) {
 ThreadTuner::ThreadTuner(int max_threads)
     : max_threads_(std::max(1, max_threads)), chosen_(max_threads_), threads_(max_threads_) {}
 
-int ThreadTuner::record(double busy_seconds, std::uint64_t steps, double now, bool room_for_all) {
+int ThreadTuner::record(double busy_seconds, std::uint64_t steps, double now, Load load) {
   if (max_threads_ <= 1 || steps == 0) return threads_;
-  if (!room_for_all) {
-    if (threads_ == 1) one_.add(busy_seconds / steps, now);
-    chosen_ = threads_ = 1;
-    crowded_ = true;
+  if (load != Load::kMeasure) {
+    const int count = load == Load::kOneThread ? 1 : max_threads_;
+    if (threads_ == count) estimate(count).add(busy_seconds / steps, now);
+    chosen_ = threads_ = count;
+    load_decided_ = true;
     return threads_;
   }
-  if (crowded_) {  // room again: probe every thread at once
-    crowded_ = false;
-    one_.add(busy_seconds / steps, now);
-    threads_ = max_threads_;
+  if (load_decided_) {  // measuring again: the other count at once
+    load_decided_ = false;
+    estimate(threads_).add(busy_seconds / steps, now);
+    threads_ = other();
     last_probe_ = now;
     probe_busy_ = 0.0;
     probe_steps_ = 0;

@@ -2,11 +2,13 @@
 // Picks how many worker threads a world steps with, by measurement.
 //
 // On a busy machine a preempted worker holds up its pass, and one thread can
-// step faster than all. Where other work leaves no core for each thread
-// (MachineLoad), one thread steps: timing there is too noisy to choose by.
-// Otherwise the tuner keeps a running cost estimate of a step on every thread
-// and on one (time constant kTimeConstant), steps with the cheaper, and now
-// and then times a few steps with the other (a probe).
+// step faster than all. Where the machine's load decides (MachineLoad), the
+// tuner follows it: one thread while work in other sessions leaves no core for
+// each, every thread while work in the server's own session shares the cores
+// per thread. Step timings there are too noisy to choose by: they follow where
+// the kernel places the threads. Otherwise the tuner keeps a running cost
+// estimate of a step on every thread and on one (time constant kTimeConstant),
+// steps with the cheaper, and now and then times a few steps with the other (a probe).
 // Results never depend on the thread count: switching shows only in speed.
 
 #include <cstdint>
@@ -29,11 +31,13 @@ class ThreadTuner {
 
   explicit ThreadTuner(int max_threads);
 
+  // What the machine's load says (MachineLoad): nothing, or the count to step with, unprobed.
+  enum class Load { kMeasure, kOneThread, kEveryThread };
+
   // Records steps done: wall seconds spent stepping, steps, and the wall clock
-  // (seconds) at their end. Returns the thread count for the next steps. While
-  // other work leaves no room for every thread (MachineLoad::room_for), one
-  // steps and nothing is probed; when room returns, every thread is probed at once.
-  int record(double busy_seconds, std::uint64_t steps, double now, bool room_for_all = true);
+  // (seconds) at their end. Returns the thread count for the next steps. When
+  // the load stops deciding, the other count is probed at once.
+  int record(double busy_seconds, std::uint64_t steps, double now, Load load = Load::kMeasure);
   // The count the next steps use.
   int threads() const { return threads_; }
   // The count the estimates favour (threads() differs from it during a probe).
@@ -54,8 +58,8 @@ class ThreadTuner {
   int chosen_;
   int threads_;
   double last_probe_ = 0.0;
-  bool crowded_ = false;     // the last record() found no room for every thread
-  double probe_busy_ = 0.0;  // the running probe's stepping so far
+  bool load_decided_ = false;  // the last record()'s load chose the count
+  double probe_busy_ = 0.0;    // the running probe's stepping so far
   std::uint64_t probe_steps_ = 0;
   Estimate one_, all_;
 };

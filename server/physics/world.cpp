@@ -412,7 +412,11 @@ void World::step() {
   const auto seconds = [](Clock::duration d) { return std::chrono::duration<double>(d).count(); };
   const double now = seconds(end - tuner_epoch_);
   machine_load_.update(now);  // after the step's clock: a reading is not a step's cost
-  set_thread_limit(tuner_->record(seconds(end - start), 1, now, machine_load_.room_for(pool_.threads())));
+  using Load = ThreadTuner::Load;
+  const Load load = !machine_load_.room_for(pool_.threads()) ? Load::kOneThread
+                    : machine_load_.shared_per_thread()      ? Load::kEveryThread
+                                                             : Load::kMeasure;
+  set_thread_limit(tuner_->record(seconds(end - start), 1, now, load));
 }
 
 void World::advance() {

@@ -90,7 +90,7 @@ TEST_CASE("a process's session and CPU time are read from its /proc/<pid>/stat, 
   CHECK_FALSE(MachineLoad::parse_pid_stat("no name here", 100.0));
 }
 
-TEST_CASE("work in this process's own session, or on a kernel that shares time per thread, leaves every thread room",
+TEST_CASE("work in this process's own session, or on a kernel that shares time per thread, is shared per thread",
           "[server][threads]") {
   // Both cores busy with others for a second (20 ticks per 0.1 s reading on 2 CPUs).
   const auto run = [](MachineLoad& load, double session_cores) {
@@ -108,9 +108,12 @@ TEST_CASE("work in this process's own session, or on a kernel that shares time p
   CHECK(same_session.others() == Approx(2.0).margin(0.01));
   CHECK(same_session.crowding() == Approx(0.0).margin(0.01));
   CHECK(same_session.room_for(2));
+  CHECK(same_session.shared_per_thread());
   CHECK(other_sessions.crowding() == Approx(2.0).margin(0.01));
   CHECK_FALSE(other_sessions.room_for(2));
+  CHECK_FALSE(other_sessions.shared_per_thread());
   CHECK(per_thread.room_for(2));
+  CHECK(per_thread.shared_per_thread());
 }
 
 TEST_CASE("this machine's counters can be read", "[server][threads]") {

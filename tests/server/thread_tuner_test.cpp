@@ -104,8 +104,9 @@ TEST_CASE("a single-threaded pool is left alone", "[server][threads]") {
   CHECK(r.with_one == r.batches);
 }
 
-TEST_CASE("while other work leaves no room for every thread, one steps unprobed; room back, every thread is probed",
+TEST_CASE("while the machine's load decides, the tuner steps with its count unprobed, then probes the other at once",
           "[server][threads]") {
+  using Load = ThreadTuner::Load;
   ThreadTuner tuner(2);
   const auto cost = [](int threads) { return threads == 1 ? 200e-6 : 100e-6; };  // every thread cheaper
   double now = run(tuner, 0.0, 1.0, cost).now;
@@ -113,11 +114,20 @@ TEST_CASE("while other work leaves no room for every thread, one steps unprobed;
   int with_all = 0;
   for (double until = now + 2.0; now < until; now += 0.004) {
     with_all += tuner.threads() != 1;
-    tuner.record(5 * cost(tuner.threads()), 5, now, false);
+    tuner.record(5 * cost(tuner.threads()), 5, now, Load::kOneThread);
   }
   CHECK(tuner.chosen() == 1);
   CHECK(with_all <= 1);  // the batch that met the crowd
   tuner.record(5 * cost(tuner.threads()), 5, now);
-  CHECK(tuner.threads() == 2);  // the first batch with room probes every thread
+  CHECK(tuner.threads() == 2);  // the first batch measuring again probes every thread
   CHECK(time_to_choose(tuner, 2, now, 5.0, cost) <= 0.1);
+  // Every thread decided by the load, though one is cheaper by the clock: no probe of one.
+  const auto dearer = [](int threads) { return threads == 1 ? 100e-6 : 200e-6; };
+  int with_one = 0;
+  for (double until = now + 2.0; now < until; now += 0.004) {
+    with_one += tuner.threads() == 1;
+    tuner.record(5 * dearer(tuner.threads()), 5, now, Load::kEveryThread);
+  }
+  CHECK(tuner.chosen() == 2);
+  CHECK(with_one == 0);
 }
