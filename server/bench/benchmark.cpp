@@ -63,8 +63,8 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
       double(world.steps_on_one_thread() - one_thread_before) / std::max<std::uint64_t>(1, spec.steps);
   // Cores work in other sessions kept busy at the end (MachineLoad), which keeps the steps on one thread;
   // null untuned.
-  if (const double others = world.crowding_cores(); others >= 0.0)
-    j["crowding_cores"] = others;
+  if (const double crowding = world.crowding_cores(); crowding >= 0.0)
+    j["crowding_cores"] = crowding;
   else
     j["crowding_cores"] = nullptr;
   j["balls"] = world.ball_count();
