@@ -1,6 +1,8 @@
 #include "server/physics/worker_pool.h"
 
 #include <immintrin.h>
+#include <pthread.h>
+#include <sched.h>
 
 #include <algorithm>
 #include <chrono>
@@ -32,6 +34,25 @@ std::uint64_t claims_word(std::uint32_t tag, std::uint32_t front, std::uint32_t 
   return std::uint64_t{tag} << 32 | std::uint64_t{front} << 16 | back;
 }
 
+// The CPUs this process may run on.
+std::vector<int> allowed_cpus() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  std::vector<int> cpus;
+  if (sched_getaffinity(0, sizeof set, &set) != 0) return cpus;
+  for (int c = 0; c < CPU_SETSIZE; ++c)
+    if (CPU_ISSET(c, &set)) cpus.push_back(c);
+  return cpus;
+}
+
+// Restricts a thread to `cpus`; a failure leaves it where it was, which costs only speed.
+void set_cpus(pthread_t thread, const std::vector<int>& cpus) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  for (const int c : cpus) CPU_SET(c, &set);
+  pthread_setaffinity_np(thread, sizeof set, &set);
+}
+
 void pause_until(const std::atomic<std::uint64_t>& value, std::uint64_t seen, Clock::time_point give_up) {
   for (int spins = 1; value.load(std::memory_order_acquire) == seen; ++spins) {
     _mm_pause();
@@ -48,11 +69,14 @@ WorkerPool::WorkerPool(int threads, std::uint32_t granule)
       active_limit_(thread_count_),
       chunk_start_(max_chunks() + 1),
       claims_(thread_count_),
-      items_done_(thread_count_) {
+      items_done_(thread_count_),
+      cpus_(allowed_cpus()) {
+  if (static_cast<int>(cpus_.size()) != thread_count_ || thread_count_ == 1) cpus_.clear();
   for (int t = 1; t < thread_count_; ++t) workers_.emplace_back([this, t] { worker_loop(t); });
 }
 
 WorkerPool::~WorkerPool() {
+  place_threads(false);  // a caller that outlives the pool gets every CPU back
   {
     boost::lock_guard<boost::mutex> lock(mutex_);
     stopping_ = true;
@@ -120,7 +144,23 @@ void WorkerPool::run_costly(std::uint32_t count, std::uint32_t min_per_thread, c
   run(count, phase, 1, std::max(1u, min_per_thread));
 }
 
+void WorkerPool::place_threads(bool one_per_cpu) {
+  // The caller's placement is the calling thread's own, whichever pool pinned it.
+  thread_local bool caller_pinned = false;
+  if (cpus_.empty()) return;
+  if (caller_pinned != one_per_cpu) {
+    set_cpus(pthread_self(), one_per_cpu ? std::vector<int>{cpus_[0]} : cpus_);
+    caller_pinned = one_per_cpu;
+  }
+  if (workers_pinned_ != one_per_cpu) {
+    for (int t = 1; t < thread_count_; ++t)
+      set_cpus(workers_[t - 1].native_handle(), one_per_cpu ? std::vector<int>{cpus_[t]} : cpus_);
+    workers_pinned_ = one_per_cpu;
+  }
+}
+
 void WorkerPool::run(std::uint32_t count, const Phase& phase, std::uint32_t granule, std::uint32_t min_per_thread) {
+  place_threads(active_limit_ == thread_count_);
   const int active = static_cast<int>(std::min<std::uint32_t>(count / min_per_thread, active_limit_));
   if (active <= 1) {
     if (count > 0) phase(0, count, 0);

@@ -12,6 +12,13 @@
 // carry the phase's generation: a late worker cannot take a later phase's chunk.
 // Each item is computed by exactly one thread, the same way: results never
 // depend on the thread count.
+//
+// While every thread steps, and there are as many threads as the process may
+// use CPUs, each thread is pinned to its own CPU. Unpinned, the kernel's
+// wake-up placement can put the caller and a worker on one core beside busy
+// processes on the other, a balanced-looking state it keeps, in which the two
+// take turns at one core. With a lower limit the threads run wherever the
+// kernel puts them. Threads the caller starts while pinned inherit its CPU.
 
 #include <atomic>
 #include <boost/thread/condition_variable.hpp>
@@ -74,6 +81,8 @@ class WorkerPool {
   int claim(int owner, bool from_front, std::uint32_t tag);
   void run(std::uint32_t count, const Phase& phase, std::uint32_t granule, std::uint32_t min_per_thread);
   void wait_for_chunks();
+  // Pins the threads one per CPU, or frees them to every CPU the process may use.
+  void place_threads(bool one_per_cpu);
 
   int thread_count_;
   std::uint32_t granule_;
@@ -86,6 +95,8 @@ class WorkerPool {
   std::vector<std::uint32_t> chunk_start_;  // chunk c is [start[c], start[c + 1])
   std::vector<Claims> claims_;
   std::vector<ItemCount> items_done_;  // per thread, since reset_shares()
+  std::vector<int> cpus_;              // thread t's CPU when pinned; empty: never pin
+  bool workers_pinned_ = false;
   // Phases published so far (high bits) and the threads they use (low byte).
   std::atomic<std::uint64_t> generation_{0};
   std::atomic<std::uint64_t> wake_calls_{0};

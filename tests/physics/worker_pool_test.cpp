@@ -5,6 +5,9 @@
 
 #include "server/physics/worker_pool.h"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <algorithm>
 #include <atomic>
 #include <catch2/catch.hpp>
@@ -150,4 +153,53 @@ TEST_CASE("a thread three times slower computes about a quarter of the items", "
   // when a busy machine delays the fast one.
   CHECK(median < 0.45);
   CHECK(median > 0.1);
+}
+
+namespace {
+std::vector<int> cpus_of_this_thread() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  pthread_getaffinity_np(pthread_self(), sizeof set, &set);
+  std::vector<int> cpus;
+  for (int c = 0; c < CPU_SETSIZE; ++c)
+    if (CPU_ISSET(c, &set)) cpus.push_back(c);
+  return cpus;
+}
+}  // namespace
+
+TEST_CASE("while every thread steps, each is pinned to a CPU of its own; below that, all are free again", "[pool]") {
+  const std::vector<int> allowed = cpus_of_this_thread();
+  if (allowed.size() < 2) {
+    WARN("one CPU: the pool never pins, nothing to check");
+    return;
+  }
+  const int threads = static_cast<int>(allowed.size());
+  std::vector<std::vector<int>> seen(threads);  // each thread's CPUs as it ran a chunk
+  {
+    WorkerPool pool(threads, 1);
+    const std::thread::id caller = std::this_thread::get_id();
+    std::atomic<int> workers_seen{0};
+    pool.set_worker_hook([&](int thread) {
+      if (seen[thread].empty()) seen[thread] = cpus_of_this_thread(), ++workers_seen;
+    });
+    pool.run(threads * 4096, [&](std::uint32_t, std::uint32_t, int) {
+      if (std::this_thread::get_id() == caller) seen[0] = cpus_of_this_thread();
+    });
+    // A worker may pick the phase up after the caller has done it all.
+    const Clock::time_point give_up = Clock::now() + std::chrono::seconds(10);
+    while (workers_seen.load() < threads - 1 && Clock::now() < give_up) std::this_thread::yield();
+    for (int t = 0; t < threads; ++t) {
+      INFO("thread " << t);
+      REQUIRE(seen[t].size() == 1);
+      CHECK(seen[t][0] == allowed[t]);
+    }
+
+    pool.set_active_limit(1);
+    pool.run(threads * 4096, [](std::uint32_t, std::uint32_t, int) {});
+    CHECK(cpus_of_this_thread() == allowed);
+    pool.set_active_limit(threads);
+    pool.run(threads * 4096, [](std::uint32_t, std::uint32_t, int) {});
+    CHECK(cpus_of_this_thread().size() == 1);
+  }
+  CHECK(cpus_of_this_thread() == allowed);  // the pool gave the caller its CPUs back
 }
