@@ -21,7 +21,7 @@ double peak_rss_mib() {
 nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleReport& settle) {
   // The cores' placement before and after: it moves the figures of scenes
   // whose threads share lines (line_transfer.h).
-  const std::optional<LineTransfer> transfer_before = time_line_transfer();
+  const std::optional<LineTransfer> transfer_before = time_line_transfer(world.cpus());
   const PhaseSeconds before = world.phase_seconds();
   const std::uint64_t rebuilds_before = world.rebuilds(), kept_before = world.lists_kept_by_checks();
   world.reset_thread_shares();
@@ -49,7 +49,7 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   const double median_rate =
       sorted.size() % 2 ? sorted[sorted.size() / 2] : 0.5 * (sorted[sorted.size() / 2 - 1] + sorted[sorted.size() / 2]);
   const PhaseSeconds& after = world.phase_seconds();
-  const std::optional<LineTransfer> transfer_after = time_line_transfer();
+  const std::optional<LineTransfer> transfer_after = time_line_transfer(world.cpus());
   const TankBounds& tank = world.params().tank;
 
   nlohmann::json j;

@@ -69,11 +69,16 @@ void answer(int cpu, Flag& flag, Flag& ready, int round_trips) {
 std::optional<LineTransfer> time_line_transfer(int round_trips) {
   cpu_set_t allowed;
   if (sched_getaffinity(0, sizeof allowed, &allowed) != 0) return std::nullopt;
+  std::vector<int> cpus;
+  for (int cpu = 0; cpu < CPU_SETSIZE && cpus.size() < 2; ++cpu)
+    if (CPU_ISSET(cpu, &allowed)) cpus.push_back(cpu);
+  return time_line_transfer(cpus, round_trips);
+}
+
+std::optional<LineTransfer> time_line_transfer(const std::vector<int>& cpus, int round_trips) {
+  if (cpus.size() < 2 || round_trips < 1) return std::nullopt;
   LineTransfer t;
-  int found = 0;
-  for (int cpu = 0; cpu < CPU_SETSIZE && found < 2; ++cpu)
-    if (CPU_ISSET(cpu, &allowed)) (found++ == 0 ? t.cpu_a : t.cpu_b) = cpu;
-  if (found < 2 || round_trips < 1) return std::nullopt;
+  t.cpu_a = cpus[0], t.cpu_b = cpus[1];
 
   Flag flag, ready;  // ready counts the threads pinned
   double seconds = 0.0;

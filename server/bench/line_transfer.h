@@ -8,6 +8,7 @@
 // which case it measured.
 
 #include <optional>
+#include <vector>
 
 namespace fishtank {
 
@@ -17,8 +18,10 @@ struct LineTransfer {
 };
 
 // Passes a flag back and forth `round_trips` times between two threads pinned
-// to the first two CPUs of this process's affinity. Empty with fewer than two
-// CPUs, or where a thread cannot be pinned.
+// to the first two of `cpus` (by default the calling thread's affinity, which a
+// stepping pool narrows to one CPU: pass World::cpus() there). Empty with fewer
+// than two CPUs, or where a thread cannot be pinned.
 std::optional<LineTransfer> time_line_transfer(int round_trips = 200000);
+std::optional<LineTransfer> time_line_transfer(const std::vector<int>& cpus, int round_trips = 200000);
 
 }  // namespace fishtank

@@ -70,8 +70,8 @@ WorkerPool::WorkerPool(int threads, std::uint32_t granule)
       chunk_start_(max_chunks() + 1),
       claims_(thread_count_),
       items_done_(thread_count_),
-      cpus_(allowed_cpus()) {
-  if (static_cast<int>(cpus_.size()) != thread_count_ || thread_count_ == 1) cpus_.clear();
+      cpus_(allowed_cpus()),
+      pins_(thread_count_ > 1 && static_cast<int>(cpus_.size()) == thread_count_) {
   for (int t = 1; t < thread_count_; ++t) workers_.emplace_back([this, t] { worker_loop(t); });
 }
 
@@ -147,7 +147,7 @@ void WorkerPool::run_costly(std::uint32_t count, std::uint32_t min_per_thread, c
 void WorkerPool::place_threads(bool one_per_cpu) {
   // The caller's placement is the calling thread's own, whichever pool pinned it.
   thread_local bool caller_pinned = false;
-  if (cpus_.empty()) return;
+  if (!pins_) return;
   if (caller_pinned != one_per_cpu) {
     set_cpus(pthread_self(), one_per_cpu ? std::vector<int>{cpus_[0]} : cpus_);
     caller_pinned = one_per_cpu;

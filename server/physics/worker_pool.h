@@ -42,6 +42,8 @@ class WorkerPool {
   WorkerPool& operator=(const WorkerPool&) = delete;
 
   int threads() const { return thread_count_; }
+  // The CPUs the process could use when the pool was made, in order.
+  const std::vector<int>& cpus() const { return cpus_; }
   int max_chunks() const { return thread_count_ * kChunksPerThread; }
   // Passes use at most this many threads (1..threads()); the others stay idle.
   void set_active_limit(int limit);
@@ -95,7 +97,8 @@ class WorkerPool {
   std::vector<std::uint32_t> chunk_start_;  // chunk c is [start[c], start[c + 1])
   std::vector<Claims> claims_;
   std::vector<ItemCount> items_done_;  // per thread, since reset_shares()
-  std::vector<int> cpus_;              // thread t's CPU when pinned; empty: never pin
+  std::vector<int> cpus_;              // thread t's CPU is cpus_[t] when pinned
+  bool pins_;                          // one CPU per thread: pins while every thread steps
   bool workers_pinned_ = false;
   // Phases published so far (high bits) and the threads they use (low byte).
   std::atomic<std::uint64_t> generation_{0};

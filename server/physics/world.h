@@ -110,6 +110,8 @@ class World {
   const ContactModel& model() const { return model_; }
   const Kernels& kernels() const { return kernels_; }
   int threads() const { return pool_.threads(); }
+  // The CPUs this process could use when the world was made; its pool pins its threads to them.
+  const std::vector<int>& cpus() const { return pool_.cpus(); }
   // Steps use at most this many of the threads (results do not depend on it).
   void set_thread_limit(int limit) { pool_.set_active_limit(limit); }
   // Lets each step choose between every thread and one as the machine's load changes (ThreadTuner).
