@@ -151,8 +151,16 @@ int run_server(const fishtank::ServerOptions& o) {
   if (std::string refusal = scene.start(world); !refusal.empty()) std::cerr << "fishtank-server: " << refusal << "\n";
   fishtank::RunControl control;
   const int cores = fishtank::WorkerPool::hardware_threads();
-  std::fprintf(stderr, "fishtank-server (%s, %s, %s): dt = %.3g s, k = %g N/m, e = %g; Ctrl-C stops\n",
-               kKernels.variant, kKernels.simd, threads_text(world.threads(), cores).c_str(), world.dt(),
+  char step_rule[96];
+  if (o.physics.dt > 0.0f)
+    std::snprintf(step_rule, sizeof step_rule, "given");
+  else if (o.physics.steps_per_contact > 0)
+    std::snprintf(step_rule, sizeof step_rule, "%d steps per contact, given", o.physics.steps_per_contact);
+  else
+    std::snprintf(step_rule, sizeof step_rule, "%d steps per contact: each collision's e within %g",
+                  steps_per_contact(o.physics), double(o.physics.tolerance));
+  std::fprintf(stderr, "fishtank-server (%s, %s, %s): dt = %.3g s (%s), k = %g N/m, e = %g; Ctrl-C stops\n",
+               kKernels.variant, kKernels.simd, threads_text(world.threads(), cores).c_str(), world.dt(), step_rule,
                o.physics.stiffness, o.physics.restitution);
   fishtank::net::NetworkService network(net_options(o), server_info(world, o), control, scene, g_stop);
   if (std::string error = network.start(); !error.empty()) {

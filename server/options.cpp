@@ -91,9 +91,11 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   physics.add_options()("stiffness", po::value(&o.physics.stiffness)->default_value(defaults.stiffness, "25000"),
                         "contact spring constant k, N/m")(
       "restitution", po::value(&o.physics.restitution)->default_value(defaults.restitution, "0.6"),
-      "coefficient of restitution e, (0, 1]")("steps-per-contact",
-                                              po::value(&steps_per_contact)->default_value(steps_per_contact),
-                                              "automatic dt = contact duration / this (>= 10)")(
+      "coefficient of restitution e, (0, 1]")(
+      "tolerance", po::value(&o.physics.tolerance)->default_value(defaults.tolerance, "0.005"),
+      "largest per-collision restitution error allowed, [0.001, 0.0075]: sets the steps per contact")(
+      "steps-per-contact", po::value(&steps_per_contact)->default_value(steps_per_contact),
+      "automatic dt = contact duration / this (>= 10; 0: from --tolerance)")(
       "dt", po::value(&o.physics.dt)->default_value(0.0), "fixed time step in seconds (0: automatic)")(
       "skin", po::value(&o.physics.skin)->default_value(defaults.skin, "0.2"), "neighbour-list skin, units");
 
@@ -160,9 +162,10 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
     return fail("--status-interval must be between 0.05 and 3600 seconds");
   if (!std::isfinite(settle_time) || settle_time < 0.0 || settle_time > 1e6)
     return fail("--settle-time must be between 0 and 1e6 simulated seconds");
-  if (steps_per_contact < PhysicsParams::kMinStepsPerContact || steps_per_contact > 100000)
-    return fail("--steps-per-contact must be between " + std::to_string(PhysicsParams::kMinStepsPerContact) +
-                " and 100000, got " + std::to_string(steps_per_contact));
+  if (steps_per_contact != 0 && (steps_per_contact < PhysicsParams::kMinStepsPerContact || steps_per_contact > 100000))
+    return fail("--steps-per-contact must be 0 (from --tolerance) or between " +
+                std::to_string(PhysicsParams::kMinStepsPerContact) + " and 100000, got " +
+                std::to_string(steps_per_contact));
 
   if (port < 0 || port > 65535) return fail("--port must be between 0 and 65535, got " + std::to_string(port));
   if (!std::isfinite(o.snapshot_rate) || o.snapshot_rate < 1.0 || o.snapshot_rate > 1000.0)

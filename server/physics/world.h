@@ -172,6 +172,8 @@ class World {
   void start_from_current_state();
   // Ball i's half kick and drift into the next-step buffers (fishtank::kick_drift).
   float kick_drift(std::uint32_t i, const Float4& a);
+  // model_.lead_bound for a step whose balls move at most `fastest`.
+  void bound_lead(float fastest);
   void move_players();
   void resize(std::uint32_t n);
   void set_ghost();
@@ -211,7 +213,8 @@ class World {
   std::uint32_t next_id_ = 0;
   bool needs_rebuild_ = true;
   bool needs_initial_forces_ = false;
-  float next_max_d2_ = 0.0f;  // largest squared distance of pos_next from pos_at_build
+  float next_max_d2_ = 0.0f;   // largest squared distance of pos_next from pos_at_build
+  float fastest_next_ = 0.0f;  // largest speed in vel_half_next: bounds the next step's lead
 
   std::vector<std::uint32_t> player_ids_;
   AlignedVector<Float4> player_pos_, player_vel_;
