@@ -28,7 +28,7 @@ std::string TrajectoryRecorder::write(const World& world) {
                     "--record-constant-count keeps one count per file; ",
                     world.time(), count_, world.ball_count());
       return why + options_.path + " holds its " + std::to_string(frames()) +
-             " frames; to record the new count, start another recording with --record-from after the change";
+             " frames; to record the new count, run the server again with --record-from past the change";
     }
     count_ = world.ball_count();
   }
