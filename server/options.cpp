@@ -42,15 +42,21 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "duration", po::value(&o.duration)->default_value(0.0), "stop after this many seconds (0: run until Ctrl-C)")(
       "status-interval", po::value(&o.status_interval)->default_value(1.0), "seconds between status lines");
 
-  std::int64_t lammps_steps = static_cast<std::int64_t>(o.lammps_steps), record_every = o.record_every;
+  std::int64_t lammps_steps = static_cast<std::int64_t>(o.lammps_steps), record_every = o.record.every;
   po::options_description output("Output (written when the server stops, or after --bench)");
   output.add_options()("dump", po::value(&o.dump_path), "final state as CSV (x,y,z,vx,vy,vz,diameter,mass)")(
       "export-lammps", po::value(&o.lammps_dir),
       "write DIR/data.fishtank and DIR/in.fishtank: the final state and contact model for LAMMPS")(
       "lammps-steps", po::value(&lammps_steps)->default_value(lammps_steps), "steps the exported LAMMPS script runs")(
-      "record", po::value(&o.record_path),
-      "trajectory in LAMMPS dump format (OVITO, ASE, LAMMPS) while the server runs; with --bench, the final state")(
-      "record-every", po::value(&record_every)->default_value(record_every), "steps between recorded frames");
+      "record", po::value(&o.record.path),
+      "trajectory in LAMMPS dump format (ASE, MDAnalysis) while the server runs, ending with the final state; "
+      "with --bench, the final state")("record-every", po::value(&record_every)->default_value(record_every),
+                                       "steps between recorded frames")(
+      "record-from", po::value(&o.record.from)->default_value(0.0),
+      "simulated seconds before the first recorded frame")(
+      "record-constant-count", po::bool_switch(&o.record.constant_count),
+      "every frame holds the same balls (for MDAnalysis): start once none are queued, end at the first change of "
+      "the count");
 
   std::int64_t port = o.port, max_players = o.max_players;
   std::string control = "players";
@@ -155,7 +161,13 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   if (record_every < 1 || record_every > 1'000'000'000)
     return fail("--record-every must be between 1 and 1e9 steps, got " + std::to_string(record_every));
   o.lammps_steps = static_cast<std::uint64_t>(lammps_steps);
-  o.record_every = static_cast<std::uint32_t>(record_every);
+  o.record.every = static_cast<std::uint32_t>(record_every);
+  if (!std::isfinite(o.record.from) || o.record.from < 0.0 || o.record.from > 1e9)
+    return fail("--record-from must be between 0 and 1e9 simulated seconds");
+  if (o.record.path.empty())
+    for (const char* flag : {"record-every", "record-from", "record-constant-count"})
+      if (!vm[flag].defaulted())
+        return fail(std::string("--") + flag + " shapes a recording: give --record FILE too, or drop it");
   if (max_balls < 0 || max_balls > 10'000'000) return fail("--max-balls must be between 0 and 10000000");
   if (!std::isfinite(o.duration) || o.duration < 0.0) return fail("--duration must be a number of seconds >= 0");
   if (!std::isfinite(o.status_interval) || o.status_interval < 0.05 || o.status_interval > 3600.0)
