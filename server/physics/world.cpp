@@ -537,11 +537,11 @@ std::string World::set_max_balls(std::uint32_t max_balls) {
 
 std::string World::overlap_warning() const {
   const float overlap = max_overlap_fraction();
-  if (!overlap_too_deep(overlap)) return "";
+  if (!overlap_too_deep(overlap) || kinetic_energy() > kRestingEnergyPerBall * n_) return "";
   char text[160];
   std::snprintf(text, sizeof text,
-                "largest overlap %.0f %% of the smaller radius (over %.0f %%): k = %g N/m is too soft", 100.0 * overlap,
-                100.0 * kOverlapWarning, double(model_.k));
+                "largest resting overlap %.0f %% of the smaller radius (over %.0f %%): k = %g N/m is too soft",
+                100.0 * overlap, 100.0 * kOverlapWarning, double(model_.k));
   return text;
 }
 
