@@ -62,7 +62,9 @@ inline F8 min(F8 a, F8 b) { return {_mm256_min_ps(a.v, b.v)}; }
 inline F8 abs(F8 a) { return {_mm256_andnot_ps(_mm256_set1_ps(-0.0f), a.v)}; }  // clears the sign bit
 inline M8 operator<(F8 a, F8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_LT_OQ)}; }
 inline M8 operator>(F8 a, F8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_GT_OQ)}; }
+inline M8 operator==(F8 a, F8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_EQ_OQ)}; }
 inline M8 operator|(M8 a, M8 b) { return {_mm256_or_ps(a.v, b.v)}; }
+inline M8 operator&(M8 a, M8 b) { return {_mm256_and_ps(a.v, b.v)}; }
 inline bool any(M8 m) { return _mm256_movemask_ps(m.v) != 0; }
 inline int bits(M8 m) { return _mm256_movemask_ps(m.v); }  // lane L's flag in bit L
 // Lanes where the mask is off become zero.

@@ -61,7 +61,9 @@ inline float max_lane(F4 a) {
 }
 inline M4 operator<(F4 a, F4 b) { return {_mm_cmplt_ps(a.v, b.v)}; }
 inline M4 operator>(F4 a, F4 b) { return {_mm_cmpgt_ps(a.v, b.v)}; }
+inline M4 operator==(F4 a, F4 b) { return {_mm_cmpeq_ps(a.v, b.v)}; }
 inline M4 operator|(M4 a, M4 b) { return {_mm_or_ps(a.v, b.v)}; }
+inline M4 operator&(M4 a, M4 b) { return {_mm_and_ps(a.v, b.v)}; }
 inline bool any(M4 m) { return _mm_movemask_ps(m.v) != 0; }
 // Lanes where the mask is off become zero.
 inline F4 keep(M4 m, F4 a) { return {_mm_and_ps(m.v, a.v)}; }

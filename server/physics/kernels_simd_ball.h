@@ -199,10 +199,20 @@ struct GroupBalls {
 
 // Sum over each lane's neighbours of the contact force, into fx, fy, fz, in
 // list order as in the scalar twin. d points from ball i to its neighbour.
+// Most blocks hold contacts that last the whole step (or none): their law is
+// k x - damping v_n, with damping taken by the neighbour's kind from a table
+// made once per group; a block with a contact starting or ending takes the
+// whole law (contact_law.h). Both give the scalar twin's value.
 template <class V>
 [[gnu::always_inline]] inline void neighbour_forces(const StepArrays& s, const ContactModel& m,
                                                     const std::uint32_t* block, std::uint32_t blocks,
                                                     const GroupBalls<V>& i, V& fx, V& fy, V& fz) {
+  V kind_inv_m[kKindCount], kind_damping[kKindCount];  // a neighbour's kind is known by its 1 / mass
+  for (int k = 0; k < kKindCount; ++k) {
+    kind_inv_m[k] = V::splat(1.0f / kBallKinds[k].mass);
+    const V inv_m_sum = i.inv_m + kind_inv_m[k];
+    kind_damping[k] = whole_step_damping(m, contact_damping(m, inv_m_sum), inv_m_sum);
+  }
   const V lead_bound = V::splat(m.lead_bound);
   const V tiny = V::splat(1e-12f);  // squared distance floor: coincident centres stay finite
   fx = fy = fz = V::zero();
@@ -220,11 +230,18 @@ template <class V>
     Lanes<V>::load(s.vel_half, block, dvx, dvy, dvz, inv_mj);
     dvx -= i.vx, dvy -= i.vy, dvz -= i.vz;
     const V inv_dist = simd::rsqrt(max(d2, tiny));
-    const V dist = d2 * inv_dist;
+    const V overlap = reach - d2 * inv_dist;
     const V v_n = mul_add(dvz, dz, mul_add(dvy, dy, dvx * dx)) * inv_dist;
-    const V inv_m_sum = i.inv_m + inv_mj;
-    const V f = normal_force(m, reach - dist, v_n, contact_damping(m, inv_m_sum), inv_m_sum);
-    const V f_over_dist = keep(near, f * inv_dist);
+    V f;
+    if (simd::any(near & starting_or_ending(m, overlap, v_n))) [[unlikely]] {
+      const V inv_m_sum = i.inv_m + inv_mj;
+      f = keep(near, normal_force(m, overlap, v_n, contact_damping(m, inv_m_sum), inv_m_sum));
+    } else {
+      V damping = kind_damping[0];
+      for (int k = 1; k < kKindCount; ++k) damping = select(inv_mj == kind_inv_m[k], kind_damping[k], damping);
+      f = whole_or_no_contact_force(m, overlap, v_n, damping);
+    }
+    const V f_over_dist = f * inv_dist;
     fx = neg_mul_add(f_over_dist, dx, fx);
     fy = neg_mul_add(f_over_dist, dy, fy);
     fz = neg_mul_add(f_over_dist, dz, fz);
