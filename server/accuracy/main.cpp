@@ -3,6 +3,7 @@
 //   fishtank-accuracy [--out DIR] [--quick] [--scalar] [--collisions-only]
 //
 // Writes to DIR (default .):
+//   rows.csv              a ball hitting a row of 1, 2 or 4 (chain, cradle): error per steps per contact
 //   collisions.csv        the worst collision of every kind per e and steps per contact (the tolerance rule)
 //   accuracy.csv          scene, method, n, dt, error, CPU seconds per run
 //   accuracy-orders.csv   observed order of each scene and method, vs dt and vs CPU time
@@ -21,6 +22,7 @@
 
 #include "server/accuracy/collisions.h"
 #include "server/accuracy/reference.h"
+#include "server/accuracy/rows.h"
 #include "server/accuracy/stability.h"
 #include "server/accuracy/sweep.h"
 #include "server/physics/params.h"
@@ -108,6 +110,18 @@ void run_collisions(const Options& o) {
     }
 }
 
+// A ball hitting a row (a three-ball chain, a five-ball cradle), against the RK4 reference.
+void run_rows(const Options& o) {
+  std::ofstream csv = open_csv(o, "rows.csv", "balls,steps_per_contact,error");
+  std::printf("\nmulti-contact rows: largest final velocity error / approach speed\n");
+  for (int balls : {2, 3, 5})
+    for (int n : {10, 13, 20, 28, 40, 56, 80}) {
+      const double error = row_error(Row{balls, 2.5e4, 0.6, 1.0}, *o.kernels, n);
+      csv << balls << ',' << n << ',' << error << '\n';
+      std::printf("  %d balls, n = %2d: %.3e\n", balls, n, error);
+    }
+}
+
 void run_accuracy(const Options& o, const SceneConfig& config) {
   const std::vector<int> n_values =
       o.quick ? std::vector<int>{10, 20, 40, 80} : std::vector<int>{5, 10, 20, 40, 80, 160, 320, 640};
@@ -176,6 +190,7 @@ int main(int argc, char** argv) {
   try {
     run_collisions(o);
     if (o.collisions_only) return 0;
+    run_rows(o);
     run_accuracy(o, SceneConfig{2.5e4, 0.6, o.kernels});
     run_stability(o);
   } catch (const std::exception& e) {
