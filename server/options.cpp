@@ -99,7 +99,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "restitution", po::value(&o.physics.restitution)->default_value(defaults.restitution, "0.6"),
       "coefficient of restitution e, (0, 1]")(
       "tolerance", po::value(&o.physics.tolerance)->default_value(defaults.tolerance, "0.005"),
-      "largest per-collision restitution error allowed, [0.001, 0.0075]: sets the steps per contact")(
+      "largest per-collision restitution error allowed, [0.002, 0.0075]: sets the steps per contact")(
       "steps-per-contact", po::value(&steps_per_contact)->default_value(steps_per_contact),
       "automatic dt = contact duration / this (>= 10; 0: from --tolerance)")(
       "dt", po::value(&o.physics.dt)->default_value(0.0), "fixed time step in seconds (0: automatic)")(

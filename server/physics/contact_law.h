@@ -18,8 +18,10 @@
 //
 // and the spring's impulse is k times the overlap's integral over the part of
 // the window in contact (a triangle where it starts or ends, x itself where it
-// lasts). The dashpot acts over that part, f dt, on the relative speed solved
-// implicitly for this contact alone: beta = c f dt / (2 m_eff) and
+// lasts). Where it starts or ends, the lead is taken once more from the rate at
+// mid-window, after the spring's half kick: start and end then mirror each
+// other, and an elastic contact neither gains nor loses energy on average. The dashpot acts over that part, f dt, on
+// the relative speed solved implicitly for this contact alone: beta = c f dt / (2 m_eff) and
 //   F = k mean_overlap - c f / (1 + beta) v_n.
 // The implicit factor touches the dashpot only, so a resting contact (v_n = 0)
 // rests on k x. That is the pair's trapezoid rule on a spring k (1 + beta),
@@ -55,13 +57,25 @@ inline bool may_touch(const ContactModel& m, float overlap, float v_n) {
   return overlap + std::fabs(v_n) * m.half_dt > 0.0f;
 }
 
-inline float normal_force(const ContactModel& m, float overlap, float v_n, float c, float inv_m_sum) {
-  const float lead = std::fabs(v_n) * m.half_dt;
+// The fraction of the window in contact and the overlap's mean over the window, for a lead.
+struct WindowContact {
+  float fraction, mean_overlap;
+};
+
+inline WindowContact window_contact(float overlap, float lead) {
   const float reach_in = overlap + lead;
-  const float in_contact = std::clamp(reach_in / std::max(lead + lead, kSmallestLead), 0.0f, 1.0f);
-  const float mean_overlap = in_contact < 1.0f ? 0.5f * reach_in * in_contact : overlap;
-  const float c_f = c * in_contact;
-  return m.k * mean_overlap - whole_step_damping(m, c_f, inv_m_sum) * v_n;
+  const float fraction = std::clamp(reach_in / std::max(lead + lead, kSmallestLead), 0.0f, 1.0f);
+  return {fraction, fraction < 1.0f ? 0.5f * reach_in * fraction : overlap};
+}
+
+inline float normal_force(const ContactModel& m, float overlap, float v_n, float c, float inv_m_sum) {
+  WindowContact part = window_contact(overlap, std::fabs(v_n) * m.half_dt);
+  if (part.fraction > 0.0f && part.fraction < 1.0f) {
+    const float v_mid = v_n + m.k * part.mean_overlap * inv_m_sum * m.half_dt;  // after the spring's half kick
+    part = window_contact(overlap, std::fabs(v_mid) * m.half_dt);
+  }
+  const float c_f = c * part.fraction;
+  return m.k * part.mean_overlap - whole_step_damping(m, c_f, inv_m_sum) * v_n;
 }
 
 namespace {  // compiled with each SIMD file's flags: internal linkage (kernels_simd_ball.h)
@@ -77,14 +91,29 @@ template <class V>
 }
 
 template <class V>
-[[gnu::always_inline]] inline V normal_force(const ContactModel& m, V overlap, V v_n, V c, V inv_m_sum) {
-  const V half_dt = V::splat(m.half_dt), one = V::splat(1.0f);
-  const V lead = abs(v_n) * half_dt;
+struct WindowContactV {
+  V fraction, mean_overlap;
+};
+
+template <class V>
+[[gnu::always_inline]] inline WindowContactV<V> window_contact(V overlap, V lead) {
+  const V one = V::splat(1.0f);
   const V reach_in = overlap + lead;
-  const V in_contact = min(max(reach_in / max(lead + lead, V::splat(kSmallestLead)), V::zero()), one);
-  const V mean_overlap = select(in_contact < one, V::splat(0.5f) * reach_in * in_contact, overlap);
-  const V c_f = c * in_contact;
-  return V::splat(m.k) * mean_overlap - whole_step_damping(m, c_f, inv_m_sum) * v_n;
+  const V fraction = min(max(reach_in / max(lead + lead, V::splat(kSmallestLead)), V::zero()), one);
+  return {fraction, select(fraction < one, V::splat(0.5f) * reach_in * fraction, overlap)};
+}
+
+template <class V>
+[[gnu::always_inline]] inline V normal_force(const ContactModel& m, V overlap, V v_n, V c, V inv_m_sum) {
+  const V half_dt = V::splat(m.half_dt);
+  WindowContactV<V> part = window_contact(overlap, abs(v_n) * half_dt);
+  const auto partial = (part.fraction > V::zero()) & (part.fraction < V::splat(1.0f));
+  const V v_mid = v_n + V::splat(m.k) * part.mean_overlap * inv_m_sum * half_dt;  // after the spring's half kick
+  const WindowContactV<V> mid = window_contact(overlap, abs(v_mid) * half_dt);
+  part.fraction = select(partial, mid.fraction, part.fraction);
+  part.mean_overlap = select(partial, mid.mean_overlap, part.mean_overlap);
+  const V c_f = c * part.fraction;
+  return V::splat(m.k) * part.mean_overlap - whole_step_damping(m, c_f, inv_m_sum) * v_n;
 }
 
 // Lanes that start or end touching within half a step, whose force needs the

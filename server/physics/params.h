@@ -12,7 +12,7 @@
 // the contact law of contact_law.h every collision's error is second order,
 // at most kToleranceRule / n^2 over e = 0.05 ... 1, every pair, wall and player,
 // 0.1 ... 20 m/s and any phase (fishtank-accuracy's collisions.csv measures it;
-// docs/accuracy.md). Below 0.001 float32 positions set the floor for slow contacts.
+// docs/accuracy.md). Below 0.002 float32 positions set the floor for slow contacts.
 //
 // m_eff,min is the lightest pair's (two balls of the lightest kind; a wall or
 // the player, being kinematic, gives a ball its own mass, twice that). Damping
@@ -39,9 +39,9 @@ struct PhysicsParams {
   TankBounds tank;
 
   static constexpr int kMinStepsPerContact = 10;
-  static constexpr float kToleranceRule = 0.75f;       // worst error times n^2
-  static constexpr float kTightestTolerance = 0.001f;  // float32 positions' floor at 0.1 m/s
-  static constexpr float kLoosestTolerance = kToleranceRule / (kMinStepsPerContact * kMinStepsPerContact);
+  static constexpr float kToleranceRule = 0.8f;        // worst error times n^2, at most
+  static constexpr float kTightestTolerance = 0.002f;  // float32 positions floor for a 0.1 m/s contact
+  static constexpr float kLoosestTolerance = 0.0075f;  // 11 steps: the rule's margin over kMinStepsPerContact
 };
 
 // Everything the kernels need, derived once from PhysicsParams.

@@ -27,3 +27,18 @@ TEST_CASE("every collision at the default settings is within 0.005 of the model'
   CHECK(errors.within_5e3 >= 0.95 * errors.collisions);
   CHECK(errors.worst <= 0.01f);
 }
+
+TEST_CASE("each tolerance meets itself: every collision at the steps it sets is within it",
+          "[physics][restitution][sweep]") {
+  const float tolerance =
+      GENERATE(0.0075f, 0.005f, 0.003f, 0.002f);  // the loosest and the tightest accepted among them
+  PhysicsParams params = open_space();
+  params.tolerance = tolerance;
+  for (float e : kSweepRestitutions) {
+    params.restitution = e;
+    const CollisionErrors errors = sweep_collisions(kSseKernels, params, every_collision(kSweepSpeeds, kSweepPhases));
+    INFO("tolerance " << tolerance << " (" << steps_per_contact(params) << " steps per contact), e = " << e
+                      << ": worst " << errors.worst << " (" << errors.worst_case << ")");
+    CHECK(errors.worst <= tolerance);
+  }
+}

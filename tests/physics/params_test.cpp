@@ -20,7 +20,7 @@ TEST_CASE("automatic dt resolves the shortest contact in the tolerance's steps, 
   PhysicsParams p;
   const float t_c = 3.14159265f * std::sqrt(0.5f / p.stiffness);  // two unit masses: m_eff = 0.5
   CHECK(contact_duration(p.stiffness) == Approx(t_c));
-  // The default tolerance 0.005: ceil(sqrt(0.75 / 0.005)) = 13 steps; t_c = 14.05 ms, 925 steps per second.
+  // The default tolerance 0.005: ceil(sqrt(0.8 / 0.005)) = 13 steps; t_c = 14.05 ms, 925 steps per second.
   CHECK(steps_per_contact(p) == 13);
   CHECK(derived_dt(p) == Approx(t_c / 13));
   CHECK(1.0f / derived_dt(p) == Approx(925.3f).epsilon(0.01));
@@ -29,9 +29,9 @@ TEST_CASE("automatic dt resolves the shortest contact in the tolerance's steps, 
 }
 
 TEST_CASE("a tighter tolerance takes more steps per contact, the rule at its ends", "[params]") {
-  CHECK(steps_for_tolerance(PhysicsParams::kLoosestTolerance) == PhysicsParams::kMinStepsPerContact);
-  CHECK(steps_for_tolerance(0.002f) == 20);
-  CHECK(steps_for_tolerance(PhysicsParams::kTightestTolerance) == 28);
+  CHECK(steps_for_tolerance(PhysicsParams::kLoosestTolerance) == 11);
+  CHECK(steps_for_tolerance(0.001f) == 29);
+  CHECK(steps_for_tolerance(PhysicsParams::kTightestTolerance) == 20);
 }
 
 TEST_CASE("defaults are valid", "[params]") { CHECK(validate(PhysicsParams{}).empty()); }
