@@ -4,12 +4,15 @@ that agree with the server's own state; the controls do what they say
 bit, a time scale of one half halves the pace); refusals raise FishtankError
 and leave the connection working."""
 
+import os
 import socket
+import stat
 import time
 
 import numpy as np
 import pytest
 
+import fishtank
 from fishtank import Client, FishtankError
 
 
@@ -149,3 +152,13 @@ def test_add_balls_beyond_the_rate_limit_says_rate_limited_before_the_tank_is_fu
         with pytest.raises(FishtankError) as limited:
             tank.add_balls(100000)
     assert limited.value.code == "rate_limited" and "added 3000 of 100000" in limited.value.message
+
+
+def test_the_assembled_package_is_readable_by_every_user():
+    """Built by root (scripts/run), run by a student: no folder or file of it may be closed to others."""
+    package = os.path.dirname(fishtank.__file__)
+    for folder, _, files in os.walk(package):
+        assert stat.S_IMODE(os.stat(folder).st_mode) & 0o005 == 0o005, f"{folder} is not open to other users"
+        for name in files:
+            path = os.path.join(folder, name)
+            assert stat.S_IMODE(os.stat(path).st_mode) & 0o004, f"{path} is not readable by other users"
