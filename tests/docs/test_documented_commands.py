@@ -161,13 +161,13 @@ def lammps_dir(tmp_path_factory):
     return folder
 
 
-def run(prepared, cwd):
+def run(prepared, cwd, source):
     # python3 is the interpreter running these tests, Debian's with the packages the client needs,
     # as it is on the fresh machine the docs are written for.
     path = os.path.dirname(sys.executable) + os.pathsep + os.environ.get("PATH", "")
     done = subprocess.run(["bash", "-c", prepared], cwd=cwd, capture_output=True, text=True, timeout=120,
                           env=dict(os.environ, PATH=path))
-    assert done.returncode == 0, f"{prepared}\nexit status {done.returncode}\n{done.stdout[-3000:]}{done.stderr[-3000:]}"
+    assert done.returncode == 0, f"{source}: {prepared}\nexit status {done.returncode}\n{done.stdout[-3000:]}{done.stderr[-3000:]}"
 
 
 def skip_without_what_it_needs(command):
@@ -184,7 +184,7 @@ def skip_without_what_it_needs(command):
 def test_the_documented_command_runs(doc, command, server, lammps_dir, tmp_path):
     skip_without_what_it_needs(command)
     port = server("--balls", "300", "--threads", "1").port if needs_server(command) else 7878
-    run(prepare(command, port, lammps_dir), tmp_path)
+    run(prepare(command, port, lammps_dir), tmp_path, f"{doc} quotes `{command}`, run here as")
 
 
 def test_every_exclusion_is_a_command_the_docs_still_quote():
@@ -197,4 +197,4 @@ def test_the_exported_scripts_own_run_commands_run(lammps_dir, tmp_path):
     assert len(commands) == 2, "in.fishtank should say how to run it on one core and on every core"
     for command in commands:
         skip_without_what_it_needs(command)
-        run(f"cd {shlex.quote(str(lammps_dir))} && {command}", tmp_path)
+        run(f"cd {shlex.quote(str(lammps_dir))} && {command}", tmp_path, "in.fishtank")
