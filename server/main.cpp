@@ -71,10 +71,16 @@ int run_bench(const fishtank::ServerOptions& o) {
   fishtank::World world(o.physics, kKernels, o.threads, o.bench_spec.scene.seed);
   world.set_thread_tuning(!o.fixed_threads);
   if (!apply_max_balls(world, o)) return 2;
+  // A benchmark times the count asked for or nothing: refused before any is poured.
+  if (o.bench_spec.scene.name == "tank" && o.bench_spec.scene.balls > world.max_balls()) {
+    std::cerr << "fishtank-server: --bench refuses --balls " << o.bench_spec.scene.balls << ": the tank holds at most "
+              << world.max_balls() << "; use --balls " << world.max_balls() << " or fewer, or --scene wide for more\n";
+    return 2;
+  }
   fishtank::TrajectoryRecorder recorder(o.record);
   if (!open_recording(recorder)) return 1;
   if (std::string refusal = fishtank::populate(world, o.bench_spec.scene); !refusal.empty()) {
-    std::cerr << "fishtank-server: " << refusal << "\n";
+    std::cerr << "fishtank-server: --bench refuses: " << refusal << "\n";
     return 2;
   }
   fishtank::SettleReport settled = fishtank::settle(world, o.bench_spec.scene);
@@ -157,6 +163,12 @@ int run_server(const fishtank::ServerOptions& o) {
   if (!apply_max_balls(world, o)) return 2;
   if (std::string refusal = scene.start(world); !refusal.empty()) std::cerr << "fishtank-server: " << refusal << "\n";
   fishtank::RunControl control;
+  fishtank::net::NetworkService network(net_options(o), server_info(world, o), control, scene, g_stop);
+  if (std::string error = network.start(); !error.empty()) {
+    std::cerr << "fishtank-server: " << error << "\n";
+    return 1;
+  }
+  // Only once it listens: a server that cannot start must not first read as one that runs.
   const int cores = fishtank::WorkerPool::hardware_threads();
   char step_rule[96];
   if (o.physics.dt > 0.0f)
@@ -169,11 +181,6 @@ int run_server(const fishtank::ServerOptions& o) {
   std::fprintf(stderr, "fishtank-server (%s, %s, %s): dt = %.3g s (%s), k = %g N/m, e = %g; Ctrl-C stops\n",
                kKernels.variant, kKernels.simd, threads_text(world.threads(), cores).c_str(), world.dt(), step_rule,
                o.physics.stiffness, o.physics.restitution);
-  fishtank::net::NetworkService network(net_options(o), server_info(world, o), control, scene, g_stop);
-  if (std::string error = network.start(); !error.empty()) {
-    std::cerr << "fishtank-server: " << error << "\n";
-    return 1;
-  }
   fishtank::TrajectoryRecorder recorder(o.record);
   if (!open_recording(recorder)) return 1;
   fishtank::LoopOptions loop;

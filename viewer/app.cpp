@@ -17,6 +17,7 @@
 #include "viewer/frame_pacer.h"
 #include "viewer/frame_stats.h"
 #include "viewer/hud.h"
+#include "viewer/hud_text.h"
 #include "viewer/input.h"
 #include "viewer/live_plots.h"
 #include "viewer/net/client.h"
@@ -84,6 +85,45 @@ class FullscreenToggle {
   int x_ = 40, y_ = 40;  // where the window returns to
 };
 
+// The terminal hears of each new reason that no connection is made once, not at every retry.
+void report_connection(const ConnectionStatus& s, const std::string& hint, std::string& reported) {
+  if (s.state == ConnectionStatus::State::connected) {
+    if (!reported.empty()) std::fprintf(stderr, "fishtank-viewer: connected to %s\n", s.endpoint.c_str());
+    reported.clear();
+    return;
+  }
+  if (s.last_error.empty() || s.last_error == reported) return;
+  reported = s.last_error;
+  std::fprintf(stderr, "fishtank-viewer: no connection to %s: %s; retrying every second. %s\n",
+               s.endpoint.c_str(), s.last_error.c_str(), hint.c_str());
+}
+
+// The exit summary: the rates of the frames that drew the scene, or, when none
+// did, the frames drawn while waiting and why nothing came.
+void print_summary(const FrameStats& stats, const ConnectionStatus& s, std::uint32_t balls) {
+  const auto rate = [](std::uint64_t frames, double seconds) {
+    return seconds > 0.0 ? (frames - 1) / seconds : 0.0;
+  };
+  if (stats.total_frames() == 0) {
+    std::fprintf(
+        stderr,
+        "fishtank-viewer: %llu frames in %.2f s (%.1f fps), none with the scene: no snapshot from %s%s%s\n",
+        static_cast<unsigned long long>(stats.all_frames()), stats.all_seconds(),
+        rate(stats.all_frames(), stats.all_seconds()), s.endpoint.c_str(), s.last_error.empty() ? "" : ": ",
+        s.last_error.c_str());
+    return;
+  }
+  const std::uint64_t waiting = stats.all_frames() - stats.total_frames();
+  std::fprintf(
+      stderr, "fishtank-viewer: %llu frames in %.2f s (%.1f fps), %.3f ms CPU per frame outside GL, %u balls",
+      static_cast<unsigned long long>(stats.total_frames()), stats.total_seconds(),
+      rate(stats.total_frames(), stats.total_seconds()), stats.mean_cpu_ms(), balls);
+  if (waiting > 0)
+    std::fprintf(stderr, "; before them %llu frames waiting for the server",
+                 static_cast<unsigned long long>(waiting));
+  std::fprintf(stderr, "\n");
+}
+
 }  // namespace
 
 int run_viewer(const ViewerOptions& opt) {
@@ -149,6 +189,8 @@ int run_viewer(const ViewerOptions& opt) {
     std::vector<SphereInstance> instances;
     TankBounds framed;  // the camera frames the tank again only if a server's tank differs
     int frames_since_snapshot = 0;
+    const std::string server_hint = server_command_hint(opt.host, opt.port);
+    std::string reported_error;
     const double started = steady_seconds();
 
     while (!glfwWindowShouldClose(window)) {
@@ -178,6 +220,7 @@ int run_viewer(const ViewerOptions& opt) {
       RenderPair pair;
       const bool have_frame = snapshots.frame_at(frame_start, pair);
       const ConnectionStatus status = net.status();
+      report_connection(status, server_hint, reported_error);
       int own = -1;
       instances.clear();
       if (have_frame && status.info) {
@@ -195,6 +238,7 @@ int run_viewer(const ViewerOptions& opt) {
       view.frame_ms = stats.frame_ms();
       view.cpu_ms = stats.cpu_ms();
       view.net = &status;
+      view.server_hint = server_hint;
       view.snapshot = newest.get();
       view.render_delay_ms = static_cast<float>(1e3 * snapshots.render_delay());
       view.observer = opt.observer;
@@ -247,12 +291,7 @@ int run_viewer(const ViewerOptions& opt) {
     }
 
     const std::shared_ptr<const Snapshot> last = snapshots.newest();
-    std::fprintf(
-        stderr,
-        "fishtank-viewer: %llu frames in %.2f s (%.1f fps), %.3f ms CPU per frame outside GL, %u balls\n",
-        static_cast<unsigned long long>(stats.total_frames()), stats.total_seconds(),
-        stats.total_seconds() > 0.0 ? (stats.total_frames() - 1) / stats.total_seconds() : 0.0,
-        stats.mean_cpu_ms(), last ? last->ball_count : 0u);
+    print_summary(stats, net.status(), last ? last->ball_count : 0u);
   }
   glfwDestroyWindow(window);
   return exit_code;

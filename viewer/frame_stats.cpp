@@ -3,6 +3,8 @@
 namespace fishtank::viewer {
 
 void FrameStats::frame_done(double now, double cpu_seconds, bool scene) {
+  if (all_frames_++ == 0) all_first_ = now;
+  all_last_ = now;
   if (scene) {
     if (total_frames_++ == 0) first_ = now;
     last_ = now;

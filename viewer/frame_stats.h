@@ -20,6 +20,10 @@ class FrameStats {
   float cpu_ms() const { return cpu_ms_; }
 
   std::uint64_t total_frames() const { return total_frames_; }
+  // Every frame, with the scene or without it (waiting for a server): the summary of a viewer that never drew
+  // one.
+  std::uint64_t all_frames() const { return all_frames_; }
+  double all_seconds() const { return all_last_ - all_first_; }
   double total_seconds() const { return last_ - first_; }  // first to last scene frame
   double mean_cpu_ms() const {
     return total_frames_ ? 1e3 * total_cpu_ / static_cast<double>(total_frames_) : 0.0;
@@ -32,9 +36,9 @@ class FrameStats {
   };
   std::deque<Sample> window_;  // frames that ended in the last second
   float fps_ = 0.0f, frame_ms_ = 0.0f, cpu_ms_ = 0.0f;
-  std::uint64_t total_frames_ = 0;
+  std::uint64_t total_frames_ = 0, all_frames_ = 0;
   double total_cpu_ = 0.0;
-  double first_ = 0.0, last_ = 0.0;
+  double first_ = 0.0, last_ = 0.0, all_first_ = 0.0, all_last_ = 0.0;
 };
 
 }  // namespace fishtank::viewer

@@ -25,7 +25,12 @@ _ERROR_NAMES = {value: name for name, value in vars(ErrorCode.ErrorCode).items()
 
 
 class FishtankError(RuntimeError):
-    """The server refused something; code is the protocol's ErrorCode name (e.g. "not_paused")."""
+    """The server refused something, or could not be reached.
+
+    code is the protocol's ErrorCode name (e.g. "not_paused") for a refusal, "cannot_connect" when no
+    connection could be made and "timeout" when the server did not answer in time; message says what
+    to do about it.
+    """
 
     def __init__(self, code, message):
         super().__init__(f"{code}: {message}")
@@ -88,7 +93,8 @@ class Client:
 
     def __init__(self, host="127.0.0.1", port=7878, player=True, name="fishtank-python", timeout=10.0):
         self.timeout = timeout
-        self._sock = socket.create_connection((host, port), timeout=timeout)
+        self.address = f"{host}:{port}"
+        self._sock = self._connect(host, port)
         self._sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         self._buffer = bytearray()
         self._kinds = np.zeros(0, dtype=np.uint8)
@@ -181,6 +187,22 @@ class Client:
 
     def __exit__(self, *exc):
         self.close()
+
+    # ---- connecting ----
+
+    def _connect(self, host, port):
+        try:
+            return socket.create_connection((host, port), timeout=self.timeout)
+        except ConnectionRefusedError:
+            raise FishtankError("cannot_connect", f"nothing listens at {self.address} (connection refused); start a "
+                                f"server there with build/server/fishtank-server --port {port}, or use the port "
+                                "its 'listening on' line shows") from None
+        except TimeoutError:
+            raise FishtankError("timeout", f"no answer from {self.address} within {self.timeout:g} s; check "
+                                "the address, and that a server on another machine was started with "
+                                "--bind 0.0.0.0") from None
+        except OSError as e:
+            raise FishtankError("cannot_connect", f"cannot connect to {self.address}: {e.strerror or e}") from None
 
     # ---- sending ----
 
@@ -279,13 +301,21 @@ class Client:
         while not self._handle_buffered():
             left = deadline - time.monotonic()
             if left <= 0:
-                raise TimeoutError("no answer from the server in time")
+                raise self._timed_out()
             self._sock.settimeout(left)
-            chunk = self._sock.recv(1 << 20)
+            try:
+                chunk = self._sock.recv(1 << 20)
+            except TimeoutError:  # socket.timeout is TimeoutError since Python 3.10
+                raise self._timed_out() from None
             if not chunk:
                 raise ConnectionError("the server closed the connection" + self._last_error_text())
             self._buffer += chunk
         self._sock.settimeout(self.timeout)
+
+    def _timed_out(self):
+        return FishtankError("timeout", f"no answer from the server at {self.address} within {self.timeout:g} s; "
+                             "it may be stopped or overloaded (its status line says which), or give "
+                             "Client(..., timeout=) more seconds")
 
     def _last_error_text(self):
         return f" ({self.errors[-1]})" if self.errors else ""

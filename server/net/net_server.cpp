@@ -24,6 +24,10 @@ std::string NetServer::listen(const std::string& address, std::uint16_t port) {
   if (!ec) acceptor_.set_option(tcp::acceptor::reuse_address(true), ec);
   if (!ec) acceptor_.bind(endpoint, ec);
   if (!ec) acceptor_.listen(asio::socket_base::max_listen_connections, ec);
+  if (ec == asio::error::address_in_use)
+    return "cannot listen on " + address + ":" + std::to_string(port) +
+           ": another program (another fishtank-server?) holds that port; stop it, or choose another with "
+           "--port P (--port 0 picks a free one and prints it)";
   if (ec) return "cannot listen on " + address + ":" + std::to_string(port) + ": " + ec.message();
   do_accept();
   return {};

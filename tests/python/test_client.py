@@ -4,11 +4,15 @@ that agree with the server's own state; the controls do what they say
 bit, a time scale of one half halves the pace); refusals raise FishtankError
 and leave the connection working."""
 
+import os
+import socket
+import stat
 import time
 
 import numpy as np
 import pytest
 
+import fishtank
 from fishtank import Client, FishtankError
 
 
@@ -116,3 +120,45 @@ def test_refusals_raise_with_the_servers_reason_and_the_connection_keeps_working
             observer.pause()
         assert refused.value.code == "not_permitted"
         assert not tank.snapshot().paused and observer.snapshot().scene == "tank"
+
+
+def test_a_port_where_nothing_listens_raises_fishtank_error_with_the_address_and_the_server_command():
+    with socket.socket() as probe:  # a port just freed: nothing listens there
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    with pytest.raises(FishtankError) as refused:
+        Client("127.0.0.1", port)
+    assert refused.value.code == "cannot_connect"
+    assert f"127.0.0.1:{port}" in refused.value.message
+    assert f"build/server/fishtank-server --port {port}" in refused.value.message
+
+
+def test_a_peer_that_never_answers_raises_fishtank_error_timeout_with_the_address_in_time():
+    with socket.socket() as silent:  # accepts connections (the kernel's backlog) and never says a word
+        silent.bind(("127.0.0.1", 0))
+        silent.listen()
+        port = silent.getsockname()[1]
+        started = time.monotonic()
+        with pytest.raises(FishtankError) as waited:
+            Client("127.0.0.1", port, timeout=0.5)
+        assert time.monotonic() - started < 5
+    assert waited.value.code == "timeout"
+    assert f"127.0.0.1:{port}" in waited.value.message and "timeout=" in waited.value.message
+
+
+def test_add_balls_beyond_the_rate_limit_says_rate_limited_before_the_tank_is_full(start_server):
+    server = start_server("--balls", "10")
+    with Client("127.0.0.1", server.port) as tank:
+        with pytest.raises(FishtankError) as limited:
+            tank.add_balls(100000)
+    assert limited.value.code == "rate_limited" and "added 3000 of 100000" in limited.value.message
+
+
+def test_the_assembled_package_is_readable_by_every_user():
+    """Built by root (scripts/run), run by a student: no folder or file of it may be closed to others."""
+    package = os.path.dirname(fishtank.__file__)
+    for folder, _, files in os.walk(package):
+        assert stat.S_IMODE(os.stat(folder).st_mode) & 0o005 == 0o005, f"{folder} is not open to other users"
+        for name in files:
+            path = os.path.join(folder, name)
+            assert stat.S_IMODE(os.stat(path).st_mode) & 0o004, f"{path} is not readable by other users"

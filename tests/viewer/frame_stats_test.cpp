@@ -31,3 +31,11 @@ TEST_CASE("the exit summary counts only frames that drew the scene") {
   CHECK(stats.total_seconds() == Approx(1.0));
   CHECK(stats.mean_cpu_ms() == Approx(1.0));
 }
+
+TEST_CASE("frames drawn while waiting for a server are counted apart, for a viewer that never connects") {
+  FrameStats stats;
+  for (int i = 0; i <= 60; ++i) stats.frame_done(i / 30.0, 0.0, false);  // 2 s at 30 fps, nothing to draw
+  CHECK(stats.total_frames() == 0);
+  CHECK(stats.all_frames() == 61);
+  CHECK(stats.all_seconds() == Approx(2.0));
+}

@@ -67,3 +67,12 @@ TEST_CASE("the control line says first whether this viewer may, then the server'
   CHECK(control_text(true, "players may") == "yours (P O R [ ] 1-4): players may");
   CHECK(control_text(false, "observers may not") == "not yours: observers may not");
 }
+
+TEST_CASE("while no server answers, the hint is the exact command that starts one at the address tried") {
+  CHECK(server_command_hint("127.0.0.1", "7913") ==
+        "To start a server here: build/server/fishtank-server --port 7913");
+  CHECK(server_command_hint("localhost", "7878") ==
+        "To start a server here: build/server/fishtank-server --port 7878");
+  CHECK(server_command_hint("otherhost", "7913") ==
+        "To start a server on otherhost: build/server/fishtank-server --bind 0.0.0.0 --port 7913");
+}

@@ -1,0 +1,43 @@
+"""Errors a new user meets first say what happened and what to do, in one
+message, and nothing before it reads as success: --bench refuses more balls
+than the tank holds and says what fits; a port in use names --port and
+--port 0, with no "Ctrl-C stops" banner first."""
+
+import os
+import re
+import signal
+import subprocess
+import time
+
+SERVER = os.path.join(os.environ["FISHTANK_BUILD_DIR"], "server", "fishtank-server")
+
+
+def test_bench_with_more_balls_than_fit_refuses_in_one_line_that_says_what_fits():
+    run = subprocess.run([SERVER, "--bench", "--balls", "7000"], capture_output=True, text=True, timeout=30)
+    assert run.returncode == 2
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1, run.stderr
+    fits = re.search(r"refuses --balls 7000: the tank holds at most (\d+); use --balls (\d+) or fewer", lines[0])
+    assert fits and fits.group(1) == fits.group(2) and 5000 < int(fits.group(1)) < 7000, lines[0]
+    assert "added" not in run.stderr and run.stdout == ""
+
+
+def test_a_port_in_use_names_the_flag_and_port_0_and_no_banner_comes_first():
+    first = subprocess.Popen([SERVER, "--port", "0", "--threads", "1", "--duration", "30"],
+                             stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True)
+    try:
+        port = None
+        deadline = time.monotonic() + 15
+        while port is None and time.monotonic() < deadline:
+            found = re.match(r"listening on 127\.0\.0\.1:(\d+)", first.stderr.readline())
+            port = found and found.group(1)
+        assert port, "the first server did not start"
+        second = subprocess.run([SERVER, "--port", port, "--threads", "1"], capture_output=True, text=True,
+                                timeout=30)
+    finally:
+        first.send_signal(signal.SIGTERM)
+        first.wait(timeout=10)
+    assert second.returncode == 1
+    assert f"cannot listen on 127.0.0.1:{port}" in second.stderr
+    assert "--port P" in second.stderr and "--port 0" in second.stderr
+    assert "Ctrl-C stops" not in second.stderr and "listening on" not in second.stderr

@@ -1,0 +1,33 @@
+"""A viewer pointed at a port where nothing listens says so on the terminal:
+the address, why (connection refused) and the exact command that starts a
+server on that port, once, not at every retry; at exit it counts the frames it
+really drew, none of them with the scene. Under Xvfb; skipped without xvfb-run."""
+
+import os
+import re
+import shutil
+import socket
+import subprocess
+
+import pytest
+
+VIEWER = os.path.join(os.environ["FISHTANK_BUILD_DIR"], "viewer", "fishtank-viewer")
+
+
+@pytest.mark.skipif(shutil.which("xvfb-run") is None, reason="xvfb-run is not installed (scripts/install-deps viewer)")
+def test_a_viewer_with_no_server_says_where_why_and_how_to_start_one_and_counts_its_frames():
+    with socket.socket() as probe:  # a port just freed: nothing listens there
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    run = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", VIEWER, "--connect",
+                          f"127.0.0.1:{port}", "--duration", "2.5", "--max-fps", "20"],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    told = [line for line in run.stderr.splitlines() if "no connection to" in line]
+    assert len(told) == 1, run.stderr  # three attempts, one reason: said once
+    assert f"127.0.0.1:{port}: cannot connect: Connection refused" in told[0]
+    assert f"To start a server here: build/server/fishtank-server --port {port}" in told[0]
+    summary = re.search(r"(\d+) frames in ([\d.]+) s \(([\d.]+) fps\), none with the scene: no snapshot from "
+                        + re.escape(f"127.0.0.1:{port}"), run.stderr)
+    assert summary, run.stderr
+    assert int(summary.group(1)) >= 20 and float(summary.group(2)) >= 2.0
