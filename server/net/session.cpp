@@ -77,7 +77,11 @@ void Session::deliver(const Reply& reply) {
   carry_out(std::move(outcome));
 }
 
-void Session::evict(const std::string& why) { carry_out(protocol_.on_evicted(why)); }
+void Session::evict(const std::string& why) {
+  // One that is ending has had its Error already: it goes at once.
+  if (close_after_write_) return close(why);
+  carry_out(protocol_.on_evicted(why));
+}
 
 void Session::do_write() {
   if (write_in_flight_ || closed_) return;
