@@ -16,6 +16,7 @@
 #include "server/bench/scenes.h"
 #include "server/export/csv_dump.h"
 #include "server/export/lammps_export.h"
+#include "server/export/trajectory_recorder.h"
 #include "server/net/network_service.h"
 #include "server/options.h"
 #include "server/realtime_loop.h"
@@ -38,20 +39,24 @@ const fishtank::Kernels& kKernels = fishtank::kScalarKernels;
 // Set by SIGINT/SIGTERM (the network service's signal_set) to end the realtime loop.
 std::atomic<bool> g_stop{false};
 
-// The final-state files asked for on the command line. A benchmark records no
-// trajectory while it is timed, so --record there writes the final state only.
-int write_final_state(const fishtank::World& world, const fishtank::ServerOptions& o) {
+// The final-state files asked for on the command line, and the recording's
+// last frame. A benchmark records no frame while it is timed, so its recording
+// holds the final state only.
+int write_final_state(const fishtank::World& world, const fishtank::ServerOptions& o,
+                      fishtank::TrajectoryRecorder& recorder) {
   std::string err;
   if (!o.dump_path.empty()) err = fishtank::write_csv_dump(world, o.dump_path);
   if (err.empty() && !o.lammps_dir.empty()) err = fishtank::export_lammps(world, o.lammps_dir, o.lammps_steps);
-  if (err.empty() && o.bench && !o.record_path.empty()) {
-    fishtank::LammpsDumpWriter recorder;
-    err = recorder.open(o.record_path);
-    if (err.empty()) err = recorder.write_frame(world);
-  }
-  if (err.empty()) return 0;
-  std::cerr << "fishtank-server: " << err << "\n";
-  return 1;
+  if (const std::string note = recorder.finish(world); !note.empty()) std::cerr << "fishtank-server: " << note << "\n";
+  if (!err.empty()) std::cerr << "fishtank-server: " << err << "\n";
+  return err.empty() && !recorder.failed() ? 0 : 1;
+}
+
+// Opens --record's file, if asked for; false (and why, on stderr) if it cannot be written.
+bool open_recording(fishtank::TrajectoryRecorder& recorder) {
+  const std::string error = recorder.open();
+  if (!error.empty()) std::cerr << "fishtank-server: " << error << "\n";
+  return error.empty();
 }
 
 // --max-balls, refused when the tank cannot hold that many.
@@ -66,6 +71,8 @@ int run_bench(const fishtank::ServerOptions& o) {
   fishtank::World world(o.physics, kKernels, o.threads, o.bench_spec.scene.seed);
   world.set_thread_tuning(!o.fixed_threads);
   if (!apply_max_balls(world, o)) return 2;
+  fishtank::TrajectoryRecorder recorder(o.record);
+  if (!open_recording(recorder)) return 1;
   if (std::string refusal = fishtank::populate(world, o.bench_spec.scene); !refusal.empty()) {
     std::cerr << "fishtank-server: " << refusal << "\n";
     return 2;
@@ -79,7 +86,7 @@ int run_bench(const fishtank::ServerOptions& o) {
   if (const std::string warning = world.overlap_warning(); !warning.empty())
     std::cerr << "fishtank-server: warning: " << warning << "\n";
   std::cout << report.dump(2) << std::endl;
-  return write_final_state(world, o);
+  return write_final_state(world, o, recorder);
 }
 
 // "2 threads", or "3 threads on 2 cores: oversubscribed": more threads than
@@ -154,22 +161,24 @@ int run_server(const fishtank::ServerOptions& o) {
   if (std::string refusal = scene.start(world); !refusal.empty()) std::cerr << "fishtank-server: " << refusal << "\n";
   fishtank::RunControl control;
   const int cores = fishtank::WorkerPool::hardware_threads();
-  std::fprintf(stderr, "fishtank-server (%s, %s, %s): dt = %.3g s, k = %g N/m, e = %g; Ctrl-C stops\n",
-               kKernels.variant, kKernels.simd, threads_text(world.threads(), cores).c_str(), world.dt(),
+  char step_rule[96];
+  if (o.physics.dt > 0.0f)
+    std::snprintf(step_rule, sizeof step_rule, "given");
+  else if (o.physics.steps_per_contact > 0)
+    std::snprintf(step_rule, sizeof step_rule, "%d steps per contact, given", o.physics.steps_per_contact);
+  else
+    std::snprintf(step_rule, sizeof step_rule, "%d steps per contact: each collision's e within %g",
+                  steps_per_contact(o.physics), double(o.physics.tolerance));
+  std::fprintf(stderr, "fishtank-server (%s, %s, %s): dt = %.3g s (%s), k = %g N/m, e = %g; Ctrl-C stops\n",
+               kKernels.variant, kKernels.simd, threads_text(world.threads(), cores).c_str(), world.dt(), step_rule,
                o.physics.stiffness, o.physics.restitution);
   fishtank::net::NetworkService network(net_options(o), server_info(world, o), control, scene, g_stop);
   if (std::string error = network.start(); !error.empty()) {
     std::cerr << "fishtank-server: " << error << "\n";
     return 1;
   }
-  fishtank::LammpsDumpWriter recorder;
-  if (!o.record_path.empty()) {
-    if (std::string error = recorder.open(o.record_path); !error.empty()) {
-      std::cerr << "fishtank-server: " << error << "\n";
-      return 1;
-    }
-  }
-  std::uint64_t next_frame = 0;  // step at which the next trajectory frame is due
+  fishtank::TrajectoryRecorder recorder(o.record);
+  if (!open_recording(recorder)) return 1;
   fishtank::LoopOptions loop;
   loop.duration = o.duration;
   loop.status_interval = o.status_interval;
@@ -177,9 +186,7 @@ int run_server(const fishtank::ServerOptions& o) {
   loop.control = &control;
   loop.at_step_boundary = [&](fishtank::World& w, const fishtank::LoopStatus& s) {
     network.at_step_boundary(w, s);
-    if (o.record_path.empty() || w.steps() < next_frame) return;
-    if (std::string error = recorder.write_frame(w); !error.empty()) spdlog::error("{}", error);
-    next_frame = w.steps() + o.record_every;
+    if (const std::string note = recorder.at_step_boundary(w); !note.empty()) spdlog::warn("{}", note);
   };
   loop.on_status = [&network, &control, &scene, cores](const fishtank::World& w, const fishtank::LoopStatus& s) {
     const std::string warning = w.overlap_warning();
@@ -191,7 +198,7 @@ int run_server(const fishtank::ServerOptions& o) {
   };
   fishtank::run_realtime(world, loop, g_stop);
   std::cerr << "fishtank-server: stopped after " << world.steps() << " steps, " << world.ball_count() << " balls\n";
-  return write_final_state(world, o);
+  return write_final_state(world, o, recorder);
 }
 
 }  // namespace

@@ -46,15 +46,21 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "duration", po::value(&o.duration)->default_value(0.0), "stop after this many seconds (0: run until Ctrl-C)")(
       "status-interval", po::value(&o.status_interval)->default_value(1.0), "seconds between status lines");
 
-  std::int64_t lammps_steps = static_cast<std::int64_t>(o.lammps_steps), record_every = o.record_every;
+  std::int64_t lammps_steps = static_cast<std::int64_t>(o.lammps_steps), record_every = o.record.every;
   po::options_description output("Output (written when the server stops, or after --bench)");
   output.add_options()("dump", po::value(&o.dump_path), "final state as CSV (x,y,z,vx,vy,vz,diameter,mass)")(
       "export-lammps", po::value(&o.lammps_dir),
       "write DIR/data.fishtank and DIR/in.fishtank: the final state and contact model for LAMMPS")(
       "lammps-steps", po::value(&lammps_steps)->default_value(lammps_steps), "steps the exported LAMMPS script runs")(
-      "record", po::value(&o.record_path),
-      "trajectory in LAMMPS dump format (OVITO, ASE, LAMMPS) while the server runs; with --bench, the final state")(
-      "record-every", po::value(&record_every)->default_value(record_every), "steps between recorded frames");
+      "record", po::value(&o.record.path),
+      "trajectory in LAMMPS dump format (ASE, MDAnalysis) while the server runs, ending with the final state; "
+      "with --bench, the final state")("record-every", po::value(&record_every)->default_value(record_every),
+                                       "steps between recorded frames")(
+      "record-from", po::value(&o.record.from)->default_value(0.0),
+      "simulated seconds before the first recorded frame")(
+      "record-constant-count", po::bool_switch(&o.record.constant_count),
+      "every frame holds the same balls (for MDAnalysis): start once none are queued, end at the first change of "
+      "the count");
 
   std::int64_t port = o.port, web_port = o.web_port, max_players = o.max_players;
   bool no_web = false;
@@ -106,9 +112,11 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   physics.add_options()("stiffness", po::value(&o.physics.stiffness)->default_value(defaults.stiffness, "25000"),
                         "contact spring constant k, N/m")(
       "restitution", po::value(&o.physics.restitution)->default_value(defaults.restitution, "0.6"),
-      "coefficient of restitution e, (0, 1]")("steps-per-contact",
-                                              po::value(&steps_per_contact)->default_value(steps_per_contact),
-                                              "automatic dt = contact duration / this (>= 10)")(
+      "coefficient of restitution e, (0, 1]")(
+      "tolerance", po::value(&o.physics.tolerance)->default_value(defaults.tolerance, "0.005"),
+      "largest per-collision restitution error allowed, [0.001, 0.0075]: sets the steps per contact")(
+      "steps-per-contact", po::value(&steps_per_contact)->default_value(steps_per_contact),
+      "automatic dt = contact duration / this (>= 10; 0: from --tolerance)")(
       "dt", po::value(&o.physics.dt)->default_value(0.0), "fixed time step in seconds (0: automatic)")(
       "skin", po::value(&o.physics.skin)->default_value(defaults.skin, "0.2"), "neighbour-list skin, units");
 
@@ -168,16 +176,23 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   if (record_every < 1 || record_every > 1'000'000'000)
     return fail("--record-every must be between 1 and 1e9 steps, got " + std::to_string(record_every));
   o.lammps_steps = static_cast<std::uint64_t>(lammps_steps);
-  o.record_every = static_cast<std::uint32_t>(record_every);
+  o.record.every = static_cast<std::uint32_t>(record_every);
+  if (!std::isfinite(o.record.from) || o.record.from < 0.0 || o.record.from > 1e9)
+    return fail("--record-from must be between 0 and 1e9 simulated seconds");
+  if (o.record.path.empty())
+    for (const char* flag : {"record-every", "record-from", "record-constant-count"})
+      if (!vm[flag].defaulted())
+        return fail(std::string("--") + flag + " shapes a recording: give --record FILE too, or drop it");
   if (max_balls < 0 || max_balls > 10'000'000) return fail("--max-balls must be between 0 and 10000000");
   if (!std::isfinite(o.duration) || o.duration < 0.0) return fail("--duration must be a number of seconds >= 0");
   if (!std::isfinite(o.status_interval) || o.status_interval < 0.05 || o.status_interval > 3600.0)
     return fail("--status-interval must be between 0.05 and 3600 seconds");
   if (!std::isfinite(settle_time) || settle_time < 0.0 || settle_time > 1e6)
     return fail("--settle-time must be between 0 and 1e6 simulated seconds");
-  if (steps_per_contact < PhysicsParams::kMinStepsPerContact || steps_per_contact > 100000)
-    return fail("--steps-per-contact must be between " + std::to_string(PhysicsParams::kMinStepsPerContact) +
-                " and 100000, got " + std::to_string(steps_per_contact));
+  if (steps_per_contact != 0 && (steps_per_contact < PhysicsParams::kMinStepsPerContact || steps_per_contact > 100000))
+    return fail("--steps-per-contact must be 0 (from --tolerance) or between " +
+                std::to_string(PhysicsParams::kMinStepsPerContact) + " and 100000, got " +
+                std::to_string(steps_per_contact));
 
   if (port < 0 || port > 65535) return fail("--port must be between 0 and 65535, got " + std::to_string(port));
   if (web_port < 0 || web_port > 65535)

@@ -7,6 +7,7 @@
 
 #include "server/bench/benchmark.h"
 #include "server/control_policy.h"
+#include "server/export/trajectory_recorder.h"
 #include "server/net/client_limits.h"
 #include "server/physics/params.h"
 
@@ -26,8 +27,7 @@ struct ServerOptions {
   std::string dump_path;
   std::string lammps_dir;              // --export-lammps
   std::uint64_t lammps_steps = 10000;  // steps the exported script runs
-  std::string record_path;             // LAMMPS dump trajectory
-  std::uint32_t record_every = 100;    // steps between frames
+  RecordOptions record;                // --record: LAMMPS dump trajectory
   PhysicsParams physics;
   // Network (not used by --bench, which never opens a socket).
   std::string bind = "127.0.0.1";

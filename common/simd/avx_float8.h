@@ -58,13 +58,19 @@ inline F8 rsqrt(F8 a) {
   return {_mm256_mul_ps(r, _mm256_add_ps(neg_half_a_r2, _mm256_set1_ps(1.5f)))};
 }
 inline F8 max(F8 a, F8 b) { return {_mm256_max_ps(a.v, b.v)}; }
+inline F8 min(F8 a, F8 b) { return {_mm256_min_ps(a.v, b.v)}; }
+inline F8 abs(F8 a) { return {_mm256_andnot_ps(_mm256_set1_ps(-0.0f), a.v)}; }  // clears the sign bit
 inline M8 operator<(F8 a, F8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_LT_OQ)}; }
 inline M8 operator>(F8 a, F8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_GT_OQ)}; }
+inline M8 operator==(F8 a, F8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_EQ_OQ)}; }
 inline M8 operator|(M8 a, M8 b) { return {_mm256_or_ps(a.v, b.v)}; }
+inline M8 operator&(M8 a, M8 b) { return {_mm256_and_ps(a.v, b.v)}; }
 inline bool any(M8 m) { return _mm256_movemask_ps(m.v) != 0; }
 inline int bits(M8 m) { return _mm256_movemask_ps(m.v); }  // lane L's flag in bit L
 // Lanes where the mask is off become zero.
 inline F8 keep(M8 m, F8 a) { return {_mm256_and_ps(m.v, a.v)}; }
+// a where the mask is on, b elsewhere.
+inline F8 select(M8 m, F8 a, F8 b) { return {_mm256_blendv_ps(b.v, a.v, m.v)}; }
 
 // Four rows of two Float4 each become columns: xs, ys, zs, ws of the eight.
 inline void transpose(F8 a, F8 b, F8 c, F8 d, F8& xs, F8& ys, F8& zs, F8& ws) {

@@ -48,6 +48,8 @@ inline F4 rsqrt(F4 a) {
   return {_mm_mul_ps(r, _mm_add_ps(neg_half_a_r2, _mm_set1_ps(1.5f)))};
 }
 inline F4 max(F4 a, F4 b) { return {_mm_max_ps(a.v, b.v)}; }
+inline F4 min(F4 a, F4 b) { return {_mm_min_ps(a.v, b.v)}; }
+inline F4 abs(F4 a) { return {_mm_andnot_ps(_mm_set1_ps(-0.0f), a.v)}; }  // clears the sign bit
 // a * b + c, rounded twice as in the scalar twin: SSE4.1 has no fused form.
 inline F4 mul_add(F4 a, F4 b, F4 c) { return a * b + c; }
 // c - a * b, rounded twice.
@@ -59,10 +61,14 @@ inline float max_lane(F4 a) {
 }
 inline M4 operator<(F4 a, F4 b) { return {_mm_cmplt_ps(a.v, b.v)}; }
 inline M4 operator>(F4 a, F4 b) { return {_mm_cmpgt_ps(a.v, b.v)}; }
+inline M4 operator==(F4 a, F4 b) { return {_mm_cmpeq_ps(a.v, b.v)}; }
 inline M4 operator|(M4 a, M4 b) { return {_mm_or_ps(a.v, b.v)}; }
+inline M4 operator&(M4 a, M4 b) { return {_mm_and_ps(a.v, b.v)}; }
 inline bool any(M4 m) { return _mm_movemask_ps(m.v) != 0; }
 // Lanes where the mask is off become zero.
 inline F4 keep(M4 m, F4 a) { return {_mm_and_ps(m.v, a.v)}; }
+// a where the mask is on, b elsewhere.
+inline F4 select(M4 m, F4 a, F4 b) { return {_mm_blendv_ps(b.v, a.v, m.v)}; }
 
 // Rows a,b,c,d (each x,y,z,w) become columns: xs, ys, zs, ws of the four.
 inline void transpose(F4 a, F4 b, F4 c, F4 d, F4& xs, F4& ys, F4& zs, F4& ws) {

@@ -1,8 +1,10 @@
 // fishtank-accuracy: the measurements of SPEC 7.1 and 7.2 (docs/accuracy.md).
 //
-//   fishtank-accuracy [--out DIR] [--quick] [--scalar]
+//   fishtank-accuracy [--out DIR] [--quick] [--scalar] [--collisions-only]
 //
 // Writes to DIR (default .):
+//   rows.csv              a ball hitting a row of 1, 2 or 4 (chain, cradle): error per steps per contact
+//   collisions.csv        the worst collision of every kind per e and steps per contact (the tolerance rule)
 //   accuracy.csv          scene, method, n, dt, error, CPU seconds per run
 //   accuracy-orders.csv   observed order of each scene and method, vs dt and vs CPU time
 //   stability.csv         the (k, dt) map with its measurements and class
@@ -18,7 +20,9 @@
 #include <string>
 #include <vector>
 
+#include "server/accuracy/collisions.h"
 #include "server/accuracy/reference.h"
+#include "server/accuracy/rows.h"
 #include "server/accuracy/stability.h"
 #include "server/accuracy/sweep.h"
 #include "server/physics/params.h"
@@ -33,6 +37,7 @@ constexpr int kFitMinSteps = 10, kFitMaxSteps = 80;
 struct Options {
   std::string out = ".";
   bool quick = false;
+  bool collisions_only = false;
   const Kernels* kernels = &kSseKernels;
 };
 
@@ -42,6 +47,8 @@ bool parse(int argc, char** argv, Options& o) {
       o.out = argv[++i];
     else if (!std::strcmp(argv[i], "--quick"))
       o.quick = true;
+    else if (!std::strcmp(argv[i], "--collisions-only"))
+      o.collisions_only = true;
     else if (!std::strcmp(argv[i], "--scalar"))
       o.kernels = &kScalarKernels;
     else
@@ -75,6 +82,44 @@ void report_drop(const SceneConfig& config) {
   for (int n = 0; n < kDropBounces; ++n)
     std::printf("  bounce %d: %.6f | %.6f (%+.2f%%) | %.6f (%+.3f%%)\n", n + 1, exact[n], ideal[n],
                 100 * (ideal[n] / exact[n] - 1), world[n], 100 * (world[n] / exact[n] - 1));
+}
+
+// The product's worst collision at each number of steps per contact (the sweep of
+// collisions.h for every e): the data of the tolerance rule (params.h).
+void run_collisions(const Options& o) {
+  const std::vector<int> n_values =
+      o.quick ? std::vector<int>{10, 20} : std::vector<int>{10, 11, 12, 13, 14, 16, 20, 28, 40};
+  std::ofstream csv = open_csv(o, "collisions.csv",
+                               "variant,steps_per_contact,restitution,collisions,within_0.005,worst,worst_times_n2");
+  std::printf("%-8s %4s %6s %10s %10s %12s\n", "variant", "n", "e", "within", "worst", "worst*n^2");
+  for (int n : n_values)
+    for (float e : kSweepRestitutions) {
+      PhysicsParams params;
+      params.gravity = 0.0f;
+      params.tank.min = {-50.0f, 0.0f, -50.0f};
+      params.tank.max = {50.0f, 100.0f, 50.0f};
+      params.restitution = e;
+      params.steps_per_contact = n;
+      const CollisionErrors r =
+          sweep_collisions(*o.kernels, params, every_collision(kSweepSpeeds, o.quick ? 5 : kSweepPhases));
+      const double scaled = double(r.worst) * n * n;
+      csv << o.kernels->variant << ',' << n << ',' << e << ',' << r.collisions << ',' << r.within_5e3 << ',' << r.worst
+          << ',' << scaled << '\n';
+      std::printf("%-8s %4d %6.2f %4d/%-5d %10.5f %12.3f  %s\n", o.kernels->variant, n, double(e), r.within_5e3,
+                  r.collisions, double(r.worst), scaled, r.worst_case.c_str());
+    }
+}
+
+// A ball hitting a row (a three-ball chain, a five-ball cradle), against the RK4 reference.
+void run_rows(const Options& o) {
+  std::ofstream csv = open_csv(o, "rows.csv", "balls,steps_per_contact,error");
+  std::printf("\nmulti-contact rows: largest final velocity error / approach speed\n");
+  for (int balls : {2, 3, 5})
+    for (int n : {10, 13, 20, 28, 40, 56, 80}) {
+      const double error = row_error(Row{balls, 2.5e4, 0.6, 1.0}, *o.kernels, n);
+      csv << balls << ',' << n << ',' << error << '\n';
+      std::printf("  %d balls, n = %2d: %.3e\n", balls, n, error);
+    }
 }
 
 void run_accuracy(const Options& o, const SceneConfig& config) {
@@ -139,11 +184,14 @@ void run_stability(const Options& o) {
 int main(int argc, char** argv) {
   Options o;
   if (!parse(argc, argv, o)) {
-    std::fprintf(stderr, "usage: fishtank-accuracy [--out DIR] [--quick] [--scalar]\n");
+    std::fprintf(stderr, "usage: fishtank-accuracy [--out DIR] [--quick] [--scalar] [--collisions-only]\n");
     return 2;
   }
   try {
-    run_accuracy(o, SceneConfig{2.0e4, 0.6, o.kernels});
+    run_collisions(o);
+    if (o.collisions_only) return 0;
+    run_rows(o);
+    run_accuracy(o, SceneConfig{2.5e4, 0.6, o.kernels});
     run_stability(o);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fishtank-accuracy: %s\n", e.what());

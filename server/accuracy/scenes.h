@@ -48,8 +48,12 @@ const std::vector<Scene>& scenes();
 // the approach speed (NaN if the contact never ends).
 inline constexpr double kHeadOnSpeed = 1.0;
 inline constexpr double kHeadOnGap = 0.05;
-double measured_restitution(const Method& method, const SceneConfig& config, double dt, int kind_a, int kind_b);
+// phase in [0, 1) shifts the start so the contact begins that far into a step.
+double measured_restitution(const Method& method, const SceneConfig& config, double dt, int kind_a, int kind_b,
+                            double phase = 0.0);
+// The worst over kHeadOnPhases phases: one collision's error depends on where in a step it starts.
 double head_on_pair_error(const Method& method, const SceneConfig& config, double dt, int kind_a, int kind_b);
+inline constexpr int kHeadOnPhases = 8;
 
 // The drop scene's constants and the apexes a run measures.
 inline constexpr double kDropHeight = 1.0;

@@ -75,6 +75,11 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   j["ns_per_ball_step"] = 1e9 / median_rate;
   j["window_ball_steps_per_s"] = rates;
   j["dt"] = world.dt();
+  // Balls this build holds in real time at this dt: ball-steps per second times simulated seconds per step.
+  j["realtime_capacity_balls"] = median_rate * world.dt();
+  j["tolerance"] = world.params().tolerance;  // per-collision restitution error the dt was chosen for
+  j["steps_per_contact"] = steps_per_contact(world.params());
+  j["dt_from_tolerance"] = world.params().steps_per_contact == 0 && world.params().dt == 0.0f;
   j["k"] = world.params().stiffness;
   j["restitution"] = world.params().restitution;
   j["max_overlap"] = world.max_overlap_fraction();

@@ -107,8 +107,11 @@ std::string export_lammps(const World& world, const std::string& dir, std::uint6
   return write_input(world, dir + "/in.fishtank", run_steps);
 }
 
-LammpsDumpWriter::~LammpsDumpWriter() {
+LammpsDumpWriter::~LammpsDumpWriter() { close(); }
+
+void LammpsDumpWriter::close() {
   if (file_) std::fclose(file_);
+  file_ = nullptr;
 }
 
 std::string LammpsDumpWriter::open(const std::string& path) {

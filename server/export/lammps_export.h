@@ -1,7 +1,7 @@
 #pragma once
 // Carrying a scene to LAMMPS (SPEC 3.7): a data file and an input script that
 // continue the current state with the same contact model, and a trajectory
-// writer in LAMMPS dump format (read by LAMMPS, OVITO, ASE and ParaView).
+// writer in LAMMPS dump format (the suite reads it with ASE and MDAnalysis).
 //
 // Mapping of the model onto LAMMPS's GRANULAR package:
 //   ball kinds 1..3         atom types 1..3, atom_style sphere (density set so mass = 1, 2, 3)
@@ -37,6 +37,7 @@ class LammpsDumpWriter {
 
   std::string open(const std::string& path);  // "" or why it failed
   std::string write_frame(const World& world);
+  void close();  // the frames so far are complete on disk; no more are written
   std::uint64_t frames() const { return frames_; }
 
  private:

@@ -9,7 +9,7 @@
 // Velocity Verlet in one pass per step, double-buffered: the pass reads
 // (pos, vel_half) of ball i and its neighbours and writes only ball i's
 // outputs, so chunks run in parallel with no races and no atomics:
-//   a    = F(pos, vel_half) / m + g
+//   a    = F(pos, vel_half) / m + g         (F: the mean force over the step, contact_law.h)
 //   v    = vel_half + a dt/2                 (the full step, not stored)
 //   vel_half_next = v + a dt/2,  pos_next = pos + vel_half_next dt
 
@@ -61,6 +61,7 @@ struct PrefetchPlan {
 // How far the balls of a chunk moved from where the lists were built.
 struct Moved {
   float max_d2 = 0.0f;        // the largest squared distance of pos_next from the build's position
+  float max_v2 = 0.0f;        // the largest squared speed in vel_half_next: the next step's lead (ContactModel)
   std::uint32_t strayed = 0;  // balls beyond StepArrays::stray_d2, listed at stray_balls + begin
 };
 

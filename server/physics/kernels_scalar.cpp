@@ -4,41 +4,38 @@
 #include <cmath>
 #include <vector>
 
+#include "server/physics/contact_law.h"
 #include "server/physics/kernels.h"
 
 namespace fishtank {
 namespace {
 
-// k x - c v_n along the normal: c from the pair's effective mass, whose
-// inverse is the sum of the two inverse masses (a kinematic body's is 0).
-inline float normal_force(const ContactModel& m, float overlap, float v_n, float inv_m_sum) {
-  return m.k * overlap - m.damping_factor / std::sqrt(inv_m_sum) * v_n;
-}
-
 // Walls are half-spaces: the force keeps growing however deep the ball is.
-inline float wall_force_1d(const ContactModel& m, float pos, float vel, float r, float inv_mass, float lo, float hi) {
+// A wall is kinematic, so the pair's inverse mass is the ball's.
+inline float wall_force_1d(const ContactModel& m, float pos, float vel, float r, float inv_mass, float c, float lo,
+                           float hi) {
   float f = 0.0f;
-  float below = lo + r - pos;
-  if (below > 0.0f) f += normal_force(m, below, vel, inv_mass);
-  float above = pos + r - hi;
-  if (above > 0.0f) f -= normal_force(m, above, -vel, inv_mass);
+  const float below = lo + r - pos, above = pos + r - hi;
+  if (may_touch(m, below, vel)) f += normal_force(m, below, vel, c, inv_mass);
+  if (may_touch(m, above, -vel)) f -= normal_force(m, above, -vel, c, inv_mass);
   return f;
 }
 
-// The spring-dashpot force on ball i from body j (a ball, or a player sphere
-// with inverse mass 0), zero unless they touch. d points from i to j, and v_n
-// is the rate at which the gap opens; the force pushes i back along -d.
+// The contact force on ball i from body j (a ball, or a player sphere with
+// inverse mass 0), zero unless they touch within half a step. d points from i
+// to j, and v_n is the rate at which the gap opens; the force pushes i back along -d.
 inline Float4 contact_force(const ContactModel& m, const Float4& pi, const Float4& vi, const Float4& pj,
                             const Float4& vj) {
   const float dx = pj.x - pi.x, dy = pj.y - pi.y, dz = pj.z - pi.z;
   const float d2 = dx * dx + dy * dy + dz * dz;
-  const float reach = pi.w + pj.w;
-  if (d2 >= reach * reach) return Float4{};
+  const float reach = pi.w + pj.w, reach_lead = reach + m.lead_bound;
+  if (!(d2 < reach_lead * reach_lead)) return Float4{};
   const float dist = std::max(std::sqrt(d2), 1e-6f);
   const float inv_dist = 1.0f / dist;
   const float nx = dx * inv_dist, ny = dy * inv_dist, nz = dz * inv_dist;
   const float v_n = (vj.x - vi.x) * nx + (vj.y - vi.y) * ny + (vj.z - vi.z) * nz;
-  const float f = normal_force(m, reach - dist, v_n, vi.w + vj.w);
+  const float inv_m_sum = vi.w + vj.w;
+  const float f = normal_force(m, reach - dist, v_n, contact_damping(m, inv_m_sum), inv_m_sum);
   return Float4{-f * nx, -f * ny, -f * nz, 0.0f};
 }
 
@@ -70,9 +67,10 @@ inline Float4 contact_force(const ContactModel& m, const Float4& pi, const Float
     fy += fp.y;
     fz += fp.z;
   }
-  fx += wall_force_1d(m, pi.x, vi.x, pi.w, vi.w, m.tank.min.x, m.tank.max.x);
-  fy += wall_force_1d(m, pi.y, vi.y, pi.w, vi.w, m.tank.min.y, m.tank.max.y);
-  fz += wall_force_1d(m, pi.z, vi.z, pi.w, vi.w, m.tank.min.z, m.tank.max.z);
+  const float c = contact_damping(m, vi.w);  // walls are kinematic: m_eff = m
+  fx += wall_force_1d(m, pi.x, vi.x, pi.w, vi.w, c, m.tank.min.x, m.tank.max.x);
+  fy += wall_force_1d(m, pi.y, vi.y, pi.w, vi.w, c, m.tank.min.y, m.tank.max.y);
+  fz += wall_force_1d(m, pi.z, vi.z, pi.w, vi.w, c, m.tank.min.z, m.tank.max.z);
   return Float4{fx * vi.w, fy * vi.w - m.gravity, fz * vi.w, 0.0f};
 }
 
@@ -99,6 +97,8 @@ Moved step(const StepArrays& arrays, const PrefetchPlan&, const ContactModel& mo
       const Float4 v{vh.x + a.x * m.half_dt, vh.y + a.y * m.half_dt, vh.z + a.z * m.half_dt, vh.w};
       const float d2 = kick_drift(m, v, s.pos[i], a, lists.at_build[i], s.vel_half_next[i], s.pos_next[i]);
       moved.max_d2 = std::max(moved.max_d2, d2);
+      const Float4& vn = s.vel_half_next[i];
+      moved.max_v2 = std::max(moved.max_v2, vn.x * vn.x + vn.y * vn.y + vn.z * vn.z);
       if (d2 > s.stray_d2) s.stray_balls[begin + moved.strayed++] = i;
     }
   }

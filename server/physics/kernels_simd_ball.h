@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "common/simd/sse_float4.h"
+#include "server/physics/contact_law.h"
 #include "server/physics/kernels.h"
 
 namespace fishtank {
@@ -197,13 +198,22 @@ struct GroupBalls {
 };
 
 // Sum over each lane's neighbours of the contact force, into fx, fy, fz, in
-// list order as in the scalar twin. d points from ball i to its neighbour;
-// f / |d| scales d itself, so the unit normal is never formed.
+// list order as in the scalar twin. d points from ball i to its neighbour.
+// Most blocks hold contacts that last the whole step (or none): their law is
+// k x - damping v_n, with damping taken by the neighbour's kind from a table
+// made once per group; a block with a contact starting or ending takes the
+// whole law (contact_law.h). Both give the scalar twin's value.
 template <class V>
 [[gnu::always_inline]] inline void neighbour_forces(const StepArrays& s, const ContactModel& m,
                                                     const std::uint32_t* block, std::uint32_t blocks,
                                                     const GroupBalls<V>& i, V& fx, V& fy, V& fz) {
-  const V k = V::splat(m.k), damping = V::splat(m.damping_factor);
+  V kind_inv_m[kKindCount], kind_damping[kKindCount];  // a neighbour's kind is known by its 1 / mass
+  for (int k = 0; k < kKindCount; ++k) {
+    kind_inv_m[k] = V::splat(1.0f / kBallKinds[k].mass);
+    const V inv_m_sum = i.inv_m + kind_inv_m[k];
+    kind_damping[k] = whole_step_damping(m, contact_damping(m, inv_m_sum), inv_m_sum);
+  }
+  const V lead_bound = V::splat(m.lead_bound);
   const V tiny = V::splat(1e-12f);  // squared distance floor: coincident centres stay finite
   fx = fy = fz = V::zero();
   // Past its end, a shorter list's lane holds the ghost: it touches nothing.
@@ -212,19 +222,26 @@ template <class V>
     Lanes<V>::load(s.pos, block, dx, dy, dz, rj);
     dx -= i.x, dy -= i.y, dz -= i.z;
     const V d2 = mul_add(dz, dz, mul_add(dy, dy, dx * dx));
-    const V reach = rj + i.r;
-    const auto touching = d2 < reach * reach;
+    const V reach = rj + i.r, reach_lead = reach + lead_bound;
+    const auto near = d2 < reach_lead * reach_lead;
     // Lists are ordered nearest first: a group's last blocks mostly hold pairs only the skin keeps.
-    if (!simd::any(touching)) continue;
+    if (!simd::any(near)) continue;
     V dvx, dvy, dvz, inv_mj;
     Lanes<V>::load(s.vel_half, block, dvx, dvy, dvz, inv_mj);
     dvx -= i.vx, dvy -= i.vy, dvz -= i.vz;
     const V inv_dist = simd::rsqrt(max(d2, tiny));
-    const V dist = d2 * inv_dist;
-    const V v_n_dist = mul_add(dvz, dz, mul_add(dvy, dy, dvx * dx));  // v_n |d|
-    // A square root and a divide, the scalar twin's value: the divider is otherwise idle here.
-    const V c = damping / sqrt(i.inv_m + inv_mj);  // damping * sqrt(m_eff)
-    const V f_over_dist = keep(touching, neg_mul_add(c, v_n_dist * inv_dist, k * (reach - dist)) * inv_dist);
+    const V overlap = reach - d2 * inv_dist;
+    const V v_n = mul_add(dvz, dz, mul_add(dvy, dy, dvx * dx)) * inv_dist;
+    V f;
+    if (simd::any(near & starting_or_ending(m, overlap, v_n))) [[unlikely]] {
+      const V inv_m_sum = i.inv_m + inv_mj;
+      f = keep(near, normal_force(m, overlap, v_n, contact_damping(m, inv_m_sum), inv_m_sum));
+    } else {
+      V damping = kind_damping[0];
+      for (int k = 1; k < kKindCount; ++k) damping = select(inv_mj == kind_inv_m[k], kind_damping[k], damping);
+      f = whole_or_no_contact_force(m, overlap, v_n, damping);
+    }
+    const V f_over_dist = f * inv_dist;
     fx = neg_mul_add(f_over_dist, dx, fx);
     fy = neg_mul_add(f_over_dist, dy, fy);
     fz = neg_mul_add(f_over_dist, dz, fz);
@@ -234,42 +251,44 @@ template <class V>
 // One axis of the six half-space walls: below the minimum face the force
 // points +axis, above the maximum face -axis; both grow with depth.
 template <class V>
-[[gnu::always_inline]] inline V wall_force(V k, V c, V p, V v, V r, float lo, float hi) {
-  const V below = V::splat(lo) + r - p;
-  const V above = p + r - V::splat(hi);
-  return keep(below > V::zero(), k * below - c * v) - keep(above > V::zero(), k * above + c * v);
+[[gnu::always_inline]] inline V wall_force(const ContactModel& m, V c, V inv_m, V p, V v, V r, float lo, float hi) {
+  return normal_force(m, V::splat(lo) + r - p, v, c, inv_m) -
+         normal_force(m, p + r - V::splat(hi), V::zero() - v, c, inv_m);
 }
 
-// a = F / m + g for a group's balls: their neighbours' forces f, plus walls
-// and player spheres.
+// a = F / m + g for a group's balls: their neighbours' forces f, plus player
+// spheres and walls, added in the scalar twin's order.
 template <class V>
 [[gnu::always_inline]] inline void acceleration(const StepArrays& s, const ContactModel& m, const GroupBalls<V>& i,
                                                 V& fx, V& fy, V& fz) {
   const TankBounds& t = m.tank;
-  const V r = i.r;
-  const auto in_wall = (V::splat(t.min.x) + r > i.x) | (i.x + r > V::splat(t.max.x)) | (V::splat(t.min.y) + r > i.y) |
-                       (i.y + r > V::splat(t.max.y)) | (V::splat(t.min.z) + r > i.z) | (i.z + r > V::splat(t.max.z));
-  if (simd::any(in_wall) || s.players > 0) {  // most groups touch no wall
-    const V k = V::splat(m.k);
-    const V c = V::splat(m.damping_factor) / sqrt(i.inv_m);  // walls and players are kinematic: m_eff = m
-    fx += wall_force(k, c, i.x, i.vx, r, t.min.x, t.max.x);
-    fy += wall_force(k, c, i.y, i.vy, r, t.min.y, t.max.y);
-    fz += wall_force(k, c, i.z, i.vz, r, t.min.z, t.max.z);
+  const V r = i.r, reach = r + V::splat(m.lead_bound);
+  const auto near_wall = (V::splat(t.min.x) + reach > i.x) | (i.x + reach > V::splat(t.max.x)) |
+                         (V::splat(t.min.y) + reach > i.y) | (i.y + reach > V::splat(t.max.y)) |
+                         (V::splat(t.min.z) + reach > i.z) | (i.z + reach > V::splat(t.max.z));
+  const bool walls = simd::any(near_wall);  // most groups touch no wall
+  if (walls || s.players > 0) {
+    const V c = contact_damping(m, i.inv_m);  // walls and players are kinematic: m_eff = m
     for (int p = 0; p < s.players; ++p) {
       const Float4 pj = s.player_pos[p], vj = s.player_vel[p];
       const V dx = V::splat(pj.x) - i.x, dy = V::splat(pj.y) - i.y, dz = V::splat(pj.z) - i.z;
       const V d2 = mul_add(dz, dz, mul_add(dy, dy, dx * dx));
-      const V reach = r + V::splat(pj.w);
-      const auto touching = d2 < reach * reach;
-      if (!simd::any(touching)) continue;
+      const V reach_lead = r + V::splat(pj.w) + V::splat(m.lead_bound);
+      const auto near = d2 < reach_lead * reach_lead;
+      if (!simd::any(near)) continue;
       const V dist = max(sqrt(d2), V::splat(1e-6f));
       const V inv_dist = V::splat(1.0f) / dist;
       const V v_n =
           ((V::splat(vj.x) - i.vx) * dx + (V::splat(vj.y) - i.vy) * dy + (V::splat(vj.z) - i.vz) * dz) * inv_dist;
-      const V f_over_dist = keep(touching, (k * (reach - dist) - c * v_n) * inv_dist);
+      const V f_over_dist = keep(near, normal_force(m, r + V::splat(pj.w) - dist, v_n, c, i.inv_m) * inv_dist);
       fx = neg_mul_add(f_over_dist, dx, fx);
       fy = neg_mul_add(f_over_dist, dy, fy);
       fz = neg_mul_add(f_over_dist, dz, fz);
+    }
+    if (walls) {
+      fx += wall_force(m, c, i.inv_m, i.x, i.vx, r, t.min.x, t.max.x);
+      fy += wall_force(m, c, i.inv_m, i.y, i.vy, r, t.min.y, t.max.y);
+      fz += wall_force(m, c, i.inv_m, i.z, i.vz, r, t.min.z, t.max.z);
     }
   }
   fx = fx * i.inv_m;
@@ -393,7 +412,7 @@ Moved step(const StepArrays& arrays, const PrefetchPlan& prefetch_plan, const Co
   const StepArrays s = arrays;
   const PrefetchPlan plan = prefetch_plan;
   const ContactModel m = model;
-  V max_d2 = V::zero();
+  V max_d2 = V::zero(), max_v2 = V::zero();
   const V stray_d2 = V::splat(s.stray_d2);
   std::uint32_t* const stray_balls = s.stray_balls + begin;
   std::uint32_t strayed = 0;
@@ -404,6 +423,7 @@ Moved step(const StepArrays& arrays, const PrefetchPlan& prefetch_plan, const Co
         const V vx = mul_add(ax, half_dt, i.vx), vy = mul_add(ay, half_dt, i.vy), vz = mul_add(az, half_dt, i.vz);
         const V hx = mul_add(ax, half_dt, vx), hy = mul_add(ay, half_dt, vy), hz = mul_add(az, half_dt, vz);
         Lanes<V>::store(hx, hy, hz, i.inv_m, s.vel_half_next, at);
+        max_v2 = max(max_v2, mul_add(hz, hz, mul_add(hy, hy, hx * hx)));
         const V px = mul_add(hx, dt, i.x), py = mul_add(hy, dt, i.y), pz = mul_add(hz, dt, i.z);
         Lanes<V>::store(px, py, pz, i.r, s.pos_next, at);
         // Where the lanes' balls were at the build: the record's first three vectors.
@@ -418,7 +438,7 @@ Moved step(const StepArrays& arrays, const PrefetchPlan& prefetch_plan, const Co
             if ((lanes & 1) && (l == 0 || at[l] != at[l - 1])) stray_balls[strayed++] = listed_index(at[l]);
         }
       });
-  return Moved{Lanes<V>::largest(max_d2), strayed};
+  return Moved{Lanes<V>::largest(max_d2), Lanes<V>::largest(max_v2), strayed};
 }
 
 template <class V>

@@ -23,8 +23,16 @@ float smallest_effective_mass() {
 
 float contact_duration(float stiffness) { return kPi * std::sqrt(smallest_effective_mass() / stiffness); }
 
+int steps_for_tolerance(float tolerance) {
+  return static_cast<int>(std::ceil(std::sqrt(PhysicsParams::kToleranceRule / tolerance) - 1e-4f));
+}
+
+int steps_per_contact(const PhysicsParams& p) {
+  return p.steps_per_contact > 0 ? p.steps_per_contact : steps_for_tolerance(p.tolerance);
+}
+
 float derived_dt(const PhysicsParams& p) {
-  return p.dt > 0.0f ? p.dt : contact_duration(p.stiffness) / static_cast<float>(p.steps_per_contact);
+  return p.dt > 0.0f ? p.dt : contact_duration(p.stiffness) / static_cast<float>(steps_per_contact(p));
 }
 
 std::string validate(const PhysicsParams& p) {
@@ -33,7 +41,14 @@ std::string validate(const PhysicsParams& p) {
     err << "stiffness k must be in (0, 1e9] N/m, got " << p.stiffness;
   else if (!std::isfinite(p.restitution) || p.restitution <= 0.0f || p.restitution > 1.0f)
     err << "restitution e must be in (0, 1], got " << p.restitution;
-  else if (p.steps_per_contact < PhysicsParams::kMinStepsPerContact || p.steps_per_contact > 100000)
+  else if (!std::isfinite(p.tolerance) || p.tolerance < PhysicsParams::kTightestTolerance ||
+           p.tolerance > PhysicsParams::kLoosestTolerance)
+    err << "tolerance must be in [" << PhysicsParams::kTightestTolerance << ", " << PhysicsParams::kLoosestTolerance
+        << "], got " << p.tolerance << ": a looser one needs fewer than " << PhysicsParams::kMinStepsPerContact
+        << " steps per contact, which is unstable; below " << PhysicsParams::kTightestTolerance
+        << " float32 positions cannot resolve a slow contact (use --steps-per-contact for more steps)";
+  else if (p.steps_per_contact != 0 &&
+           (p.steps_per_contact < PhysicsParams::kMinStepsPerContact || p.steps_per_contact > 100000))
     err << "steps per contact must be in [" << PhysicsParams::kMinStepsPerContact << ", 100000], got "
         << p.steps_per_contact;
   else if (!std::isfinite(p.dt) || p.dt < 0.0f)
@@ -43,7 +58,7 @@ std::string validate(const PhysicsParams& p) {
         << " N/m: a contact lasts t_c = " << contact_duration(p.stiffness) << " s and needs at least "
         << PhysicsParams::kMinStepsPerContact
         << " steps, so dt must be <= " << contact_duration(p.stiffness) / PhysicsParams::kMinStepsPerContact
-        << " s (automatic: " << contact_duration(p.stiffness) / p.steps_per_contact << " s)";
+        << " s (automatic: " << contact_duration(p.stiffness) / static_cast<float>(steps_per_contact(p)) << " s)";
   else if (!std::isfinite(p.skin) || p.skin <= 0.0f || p.skin > 10.0f)
     err << "neighbour skin must be in (0, 10] units, got " << p.skin;
   else if (!std::isfinite(p.gravity) || std::fabs(p.gravity) > 1000.0f)
@@ -64,6 +79,7 @@ ContactModel make_contact_model(const PhysicsParams& p) {
   m.damping_factor = 2.0f * damping_ratio(p.restitution) * std::sqrt(p.stiffness);
   m.dt = derived_dt(p);
   m.half_dt = 0.5f * m.dt;
+  m.damping_boost = 0.25f * m.damping_factor * m.damping_factor * m.dt;
   m.gravity = p.gravity;
   m.tank = p.tank;
   return m;

@@ -5,13 +5,21 @@
 //   damping ratio    zeta = -ln e / sqrt(pi^2 + ln^2 e)
 //   pair damping     c    = 2 zeta sqrt(k m_eff),   m_eff = m1 m2 / (m1 + m2)
 //   contact duration t_c  = pi sqrt(m_eff,min / k)   (undamped half period)
-//   time step        dt   = t_c / steps_per_contact
+//   time step        dt   = t_c / n
+//   steps per contact n    = ceil(sqrt(kToleranceRule / tolerance)), unless given
+//
+// The tolerance is the largest per-collision restitution error allowed. With
+// the contact law of contact_law.h every collision's error is second order,
+// at most kToleranceRule / n^2 over e = 0.05 ... 1, every pair, wall and player,
+// 0.1 ... 20 m/s and any phase (fishtank-accuracy's collisions.csv measures it;
+// docs/accuracy.md). Below 0.001 float32 positions set the floor for slow contacts.
 //
 // m_eff,min is the lightest pair's (two balls of the lightest kind; a wall or
 // the player, being kinematic, gives a ball its own mass, twice that). Damping
 // lengthens a contact (by 39 % at e = 0.05), but the damped oscillator's rates
 // still have magnitude w0 = pi / t_c, so the undamped t_c sets dt.
 
+#include <limits>
 #include <string>
 
 #include "common/overlap.h"
@@ -22,7 +30,8 @@ namespace fishtank {
 struct PhysicsParams {
   float stiffness = 2.5e4f;        // k, N/m: keeps a full tank's largest overlap under 10 % of r_min
   float restitution = 0.6f;        // e, measured rebound / approach normal speed
-  int steps_per_contact = 20;      // n in dt = t_c / n
+  float tolerance = 0.005f;        // largest per-collision restitution error: sets n
+  int steps_per_contact = 0;       // n in dt = t_c / n; 0: from the tolerance
   float dt = 0.0f;                 // 0: derive from k; otherwise must be <= t_c / kMinStepsPerContact
   float skin = 0.2f;               // neighbour-list skin, units (report, section 3: how it was chosen)
   float gravity = 9.81f;           // m/s^2, along -y
@@ -30,21 +39,31 @@ struct PhysicsParams {
   TankBounds tank;
 
   static constexpr int kMinStepsPerContact = 10;
+  static constexpr float kToleranceRule = 0.75f;       // worst error times n^2
+  static constexpr float kTightestTolerance = 0.001f;  // float32 positions' floor at 0.1 m/s
+  static constexpr float kLoosestTolerance = kToleranceRule / (kMinStepsPerContact * kMinStepsPerContact);
 };
 
 // Everything the kernels need, derived once from PhysicsParams.
 struct ContactModel {
   float k;
   float damping_factor;  // 2 zeta sqrt(k): c = damping_factor * sqrt(m_eff)
+  float damping_boost;   // damping_factor^2 dt / 4, added to c (contact_law.h says why)
   float dt;
   float half_dt;
   float gravity;
   TankBounds tank;
+  // No pair's overlap moves further than this in half a step: the fastest
+  // ball's and the faster of that and a player's speed, times dt / 2. Pairs
+  // further apart neither touch nor start to; the World sets it each step.
+  float lead_bound = std::numeric_limits<float>::infinity();
 };
 
 float damping_ratio(float restitution);
 float smallest_effective_mass();
 float contact_duration(float stiffness);
+int steps_for_tolerance(float tolerance);
+int steps_per_contact(const PhysicsParams& p);  // given, or from the tolerance
 float derived_dt(const PhysicsParams& p);
 
 // Empty when the parameters are usable; otherwise a message that says which

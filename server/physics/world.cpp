@@ -320,8 +320,17 @@ void World::add_edge_fetches(PrefetchPlan& plan, std::uint32_t begin, std::uint3
 }
 
 float World::kick_drift(std::uint32_t i, const Float4& a) {
-  return fishtank::kick_drift(model_, half_step_row(vel_[i]), pos_[i], a, pos_at_build_[i], vel_half_next_[i],
-                              pos_next_[i]);
+  const float d2 = fishtank::kick_drift(model_, half_step_row(vel_[i]), pos_[i], a, pos_at_build_[i], vel_half_next_[i],
+                                        pos_next_[i]);
+  fastest_next_ = std::max(fastest_next_, std::sqrt(squared_speed(vel_half_next_[i])));
+  return d2;
+}
+
+void World::bound_lead(float fastest) {
+  // A pair closes at most at the sum of its speeds; the rounding of v_n is covered by the margin.
+  constexpr float kMargin = 1.001f;
+  const float other = player_pos_.empty() ? fastest : std::max(fastest, params_.player_max_speed);
+  model_.lead_bound = (fastest + other) * model_.half_dt * kMargin;
 }
 
 // v(t) is the mean of vel_half = v(t - dt/2) and vel_half_next = v(t + dt/2): derived for observers,
@@ -347,11 +356,14 @@ void World::start_from_current_state() {
   if (needs_rebuild_) rebuild();
   PhaseTimer timer(phase_seconds_.step_pass);
   std::transform(vel_.begin(), vel_.end(), vel_half_.begin(), half_step_row);
+  float fastest = 0.0f;
+  for (std::uint32_t i = 0; i < n_; ++i) fastest = std::max(fastest, std::sqrt(squared_speed(vel_[i])));
+  bound_lead(fastest);
   StepArrays s = arrays();
   pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int) {
     kernels_.accelerations(s, model_, acc_.data(), begin, end);
   });
-  next_max_d2_ = 0.0f;
+  next_max_d2_ = fastest_next_ = 0.0f;
   for (std::uint32_t i = 0; i < n_; ++i) next_max_d2_ = std::max(next_max_d2_, kick_drift(i, acc_[i]));
   strayed_listed_ = false;  // this pass lists no strayed balls: past skin / 2 the lists are rebuilt
   needs_initial_forces_ = false;
@@ -430,6 +442,7 @@ void World::advance() {
   if (needs_rebuild_ || !lists_hold()) rebuild();
 
   PhaseTimer timer(phase_seconds_.step_pass);
+  bound_lead(fastest_next_);
   std::fill(chunk_moved_.begin(), chunk_moved_.end(), ChunkMoved{});
   StepArrays s = arrays();
   s.stray_d2 = half_skin_d2() * kStrayMargin;  // every ball lists_hold() will count as strayed, and a hair more
@@ -441,7 +454,12 @@ void World::advance() {
     chunk_moved_[chunk] = {begin, kernels_.step(s, chunk_plan, model_, begin, end)};
   });
   next_max_d2_ = 0.0f;
-  for (const ChunkMoved& chunk : chunk_moved_) next_max_d2_ = std::max(next_max_d2_, chunk.moved.max_d2);
+  float max_v2 = 0.0f;
+  for (const ChunkMoved& chunk : chunk_moved_) {
+    next_max_d2_ = std::max(next_max_d2_, chunk.moved.max_d2);
+    max_v2 = std::max(max_v2, chunk.moved.max_v2);
+  }
+  fastest_next_ = std::sqrt(max_v2);
   strayed_listed_ = true;
   vel_stale_ = true;
   time_ += model_.dt;
@@ -519,11 +537,11 @@ std::string World::set_max_balls(std::uint32_t max_balls) {
 
 std::string World::overlap_warning() const {
   const float overlap = max_overlap_fraction();
-  if (!overlap_too_deep(overlap)) return "";
+  if (!overlap_too_deep(overlap) || kinetic_energy() > kRestingEnergyPerBall * n_) return "";
   char text[160];
   std::snprintf(text, sizeof text,
-                "largest overlap %.0f %% of the smaller radius (over %.0f %%): k = %g N/m is too soft", 100.0 * overlap,
-                100.0 * kOverlapWarning, double(model_.k));
+                "largest resting overlap %.0f %% of the smaller radius (over %.0f %%): k = %g N/m is too soft",
+                100.0 * overlap, 100.0 * kOverlapWarning, double(model_.k));
   return text;
 }
 

@@ -16,13 +16,22 @@ TEST_CASE("damping ratio follows zeta = -ln e / sqrt(pi^2 + ln^2 e)", "[params]"
   CHECK(damping_ratio(0.1f) > damping_ratio(0.6f));
 }
 
-TEST_CASE("automatic dt resolves the shortest contact in steps_per_contact steps", "[params]") {
+TEST_CASE("automatic dt resolves the shortest contact in the tolerance's steps, or in those given", "[params]") {
   PhysicsParams p;
   const float t_c = 3.14159265f * std::sqrt(0.5f / p.stiffness);  // two unit masses: m_eff = 0.5
   CHECK(contact_duration(p.stiffness) == Approx(t_c));
-  CHECK(derived_dt(p) == Approx(t_c / p.steps_per_contact));
-  // The default k = 2.5e4 N/m: t_c = 14.05 ms, about 1420 steps per simulated second.
-  CHECK(1.0f / derived_dt(p) == Approx(1423.5f).epsilon(0.01));
+  // The default tolerance 0.005: ceil(sqrt(0.75 / 0.005)) = 13 steps; t_c = 14.05 ms, 925 steps per second.
+  CHECK(steps_per_contact(p) == 13);
+  CHECK(derived_dt(p) == Approx(t_c / 13));
+  CHECK(1.0f / derived_dt(p) == Approx(925.3f).epsilon(0.01));
+  p.steps_per_contact = 20;
+  CHECK(derived_dt(p) == Approx(t_c / 20));
+}
+
+TEST_CASE("a tighter tolerance takes more steps per contact, the rule at its ends", "[params]") {
+  CHECK(steps_for_tolerance(PhysicsParams::kLoosestTolerance) == PhysicsParams::kMinStepsPerContact);
+  CHECK(steps_for_tolerance(0.002f) == 20);
+  CHECK(steps_for_tolerance(PhysicsParams::kTightestTolerance) == 28);
 }
 
 TEST_CASE("defaults are valid", "[params]") { CHECK(validate(PhysicsParams{}).empty()); }
@@ -48,6 +57,10 @@ TEST_CASE("unstable or absurd parameters are refused with a reason", "[params]")
   SECTION("negative dt") {
     p.dt = -1.0f;
     CHECK(validate(p).find("dt") != std::string::npos);
+  }
+  SECTION("a tolerance too loose for a stable step") {
+    p.tolerance = 0.01f;
+    CHECK(validate(p).find("unstable") != std::string::npos);
   }
   SECTION("too few steps per contact") {
     p.steps_per_contact = 3;

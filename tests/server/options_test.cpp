@@ -81,7 +81,9 @@ TEST_CASE("the help text (--help) lists every flag and exits 0 without starting 
                            "--export-lammps",
                            "--lammps-steps",
                            "--record",
-                           "--record-every"}) {
+                           "--record-every",
+                           "--record-from",
+                           "--record-constant-count"}) {
     INFO(flag);
     CHECK(r.message.find(flag) != std::string::npos);
   }
@@ -123,6 +125,22 @@ TEST_CASE(
   CHECK(parse({"--control", "nobody"}).options->control == ControlPolicy::nobody);
 }
 
+TEST_CASE("the recording's flags land in its options, by default every 100 steps from t = 0 and any count",
+          "[options]") {
+  const ParseResult plain = parse({"--record", "t.dump"});
+  REQUIRE(plain.options);
+  CHECK(plain.options->record.path == "t.dump");
+  CHECK(plain.options->record.every == 100);
+  CHECK(plain.options->record.from == 0.0);
+  CHECK_FALSE(plain.options->record.constant_count);
+  const ParseResult r =
+      parse({"--record", "t.dump", "--record-every", "40", "--record-from", "2.5", "--record-constant-count"});
+  REQUIRE(r.options);
+  CHECK(r.options->record.every == 40);
+  CHECK(r.options->record.from == 2.5);
+  CHECK(r.options->record.constant_count);
+}
+
 TEST_CASE("every bad value is refused with a message naming it and exit code 2", "[options]") {
   struct Bad {
     std::vector<std::string> args;
@@ -152,12 +170,21 @@ TEST_CASE("every bad value is refused with a message naming it and exit code 2",
       {{"--max-players", "-1"}, "--max-players"},
       {{"--max-balls", "-3"}, "--max-balls"},
       {{"--record-every", "0"}, "--record-every"},
+      {{"--record", "t.dump", "--record-from", "-1"}, "--record-from must be between 0 and 1e9"},
+      {{"--record", "t.dump", "--record-from", "nan"}, "--record-from must be between 0 and 1e9"},
+      {{"--record-from", "5"}, "--record-from shapes a recording: give --record FILE too"},
+      {{"--record-every", "5"}, "--record-every shapes a recording: give --record FILE too"},
+      {{"--record-constant-count"}, "--record-constant-count shapes a recording: give --record FILE too"},
       {{"--lammps-steps", "-1"}, "--lammps-steps"},
       {{"--stiffness", "nan"}, "stiffness"},
       {{"--stiffness", "-1"}, "stiffness"},
       {{"--restitution", "0"}, "restitution"},
       {{"--restitution", "1.5"}, "restitution"},
-      {{"--steps-per-contact", "5"}, "--steps-per-contact must be between 10 and 100000, got 5"},
+      {{"--steps-per-contact", "5"},
+       "--steps-per-contact must be 0 (from --tolerance) or between 10 and 100000, got 5"},
+      {{"--tolerance", "0.02"}, "fewer than 10 steps per contact, which is unstable"},
+      {{"--tolerance", "0.0001"}, "float32 positions cannot resolve a slow contact"},
+      {{"--tolerance", "nan"}, "tolerance must be in [0.001, 0.0075]"},
       {{"--dt", "0.01"}, "unstable for k"},
       {{"--skin", "-0.1"}, "skin"},
       {{"--max-connections", "0"}, "--max-connections must be between"},

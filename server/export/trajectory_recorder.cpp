@@ -1,0 +1,45 @@
+#include "server/export/trajectory_recorder.h"
+
+#include <cstdio>
+
+namespace fishtank {
+
+std::string TrajectoryRecorder::open() {
+  ended_ = options_.path.empty();
+  return ended_ ? "" : writer_.open(options_.path);
+}
+
+std::string TrajectoryRecorder::at_step_boundary(const World& world) {
+  return world.steps() < next_frame_ ? "" : write(world);
+}
+
+std::string TrajectoryRecorder::finish(const World& world) { return last_step_ == world.steps() ? "" : write(world); }
+
+std::string TrajectoryRecorder::write(const World& world) {
+  if (ended_ || world.time() < options_.from || world.ball_count() == 0) return "";
+  if (options_.constant_count) {
+    if (frames() == 0 && world.pending() > 0) return "";  // balls are still pouring in
+    if (frames() > 0 && world.ball_count() != count_) {
+      ended_ = true;
+      writer_.close();
+      char why[256];
+      std::snprintf(why, sizeof why,
+                    "recording ended at t = %.3f s: the ball count changed from %u to %u, and "
+                    "--record-constant-count keeps one count per file; ",
+                    world.time(), count_, world.ball_count());
+      return why + options_.path + " holds its " + std::to_string(frames()) +
+             " frames; to record the new count, run the server again with --record-from past the change";
+    }
+    count_ = world.ball_count();
+  }
+  last_step_ = world.steps();
+  next_frame_ = world.steps() + options_.every;
+  std::string error = writer_.write_frame(world);
+  if (!error.empty()) {
+    ended_ = failed_ = true;
+    error += "; recording stopped";
+  }
+  return error;
+}
+
+}  // namespace fishtank

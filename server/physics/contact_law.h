@@ -1,0 +1,105 @@
+#pragma once
+// The contact law, once per twin: the scalar function first, the SIMD one
+// (any vector type V of common/simd) below it, the same arithmetic in the same
+// order. Every contact uses it: ball pairs, walls and player spheres.
+//
+// A step kicks each velocity by the force's impulse over the window
+// [t - dt/2, t + dt/2] around the positions' time t. Evaluating k x at t alone
+// (as LAMMPS does) is right while the pair overlaps for the whole window, but
+// a contact that starts or ends inside it gets an impulse that depends on where
+// in the step that happens: one collision's e then scatters by +-0.03 at 20
+// steps per contact. Here the overlap moves linearly across the window,
+//
+//        overlap                       lead = |v_n| dt/2
+//          ^          ____/            in_contact f = clamp((x + lead) / (2 lead), 0, 1)
+//          |     ___/ |                mean overlap = x                     (f = 1)
+//     0 ---+---/------+---> t                       = (x + lead) f / 2      (f < 1)
+//          t-dt/2  t  t+dt/2
+//
+// and the spring's impulse is k times the overlap's integral over the part of
+// the window in contact (a triangle where it starts or ends, x itself where it
+// lasts). The dashpot acts over that part, f dt, on the relative speed solved
+// implicitly for this contact alone: beta = c f dt / (2 m_eff) and
+//   F = k mean_overlap - c f / (1 + beta) v_n.
+// The implicit factor touches the dashpot only, so a resting contact (v_n = 0)
+// rests on k x. That is the pair's trapezoid rule on a spring k (1 + beta),
+// whose damping ratio is lower by sqrt(1 + beta); c is raised by the same
+// factor to first order, c + c^2 dt / (4 m_eff) = c + damping_factor^2 dt / 4,
+// which leaves each collision's restitution second order in dt.
+//
+// x is the overlap (negative: the gap), v_n the rate at which the gap opens,
+// inv_m_sum the pair's 1 / m_eff (a wall or a player adds 0).
+
+#include <algorithm>
+#include <cmath>
+
+#include "server/physics/params.h"
+
+namespace fishtank {
+
+// 2 lead below this is no lead: a pair at rest has none, and the fraction then only says touching or not.
+constexpr float kSmallestLead = 1e-20f;
+
+// c for a pair of inverse-mass sum inv_m_sum, raised as the header says.
+inline float contact_damping(const ContactModel& m, float inv_m_sum) {
+  return m.damping_factor / std::sqrt(inv_m_sum) + m.damping_boost;
+}
+
+// c / (1 + beta) for a contact over the fraction of the step in which c_f = c f acts.
+inline float whole_step_damping(const ContactModel& m, float c_f, float inv_m_sum) {
+  return c_f / (1.0f + c_f * m.half_dt * inv_m_sum);
+}
+
+// Whether the overlap x reaches 0 within half a step (otherwise the law gives 0).
+inline bool may_touch(const ContactModel& m, float overlap, float v_n) {
+  return overlap + std::fabs(v_n) * m.half_dt > 0.0f;
+}
+
+inline float normal_force(const ContactModel& m, float overlap, float v_n, float c, float inv_m_sum) {
+  const float lead = std::fabs(v_n) * m.half_dt;
+  const float reach_in = overlap + lead;
+  const float in_contact = std::clamp(reach_in / std::max(lead + lead, kSmallestLead), 0.0f, 1.0f);
+  const float mean_overlap = in_contact < 1.0f ? 0.5f * reach_in * in_contact : overlap;
+  const float c_f = c * in_contact;
+  return m.k * mean_overlap - whole_step_damping(m, c_f, inv_m_sum) * v_n;
+}
+
+namespace {  // compiled with each SIMD file's flags: internal linkage (kernels_simd_ball.h)
+
+template <class V>
+[[gnu::always_inline]] inline V contact_damping(const ContactModel& m, V inv_m_sum) {
+  return V::splat(m.damping_factor) / sqrt(inv_m_sum) + V::splat(m.damping_boost);
+}
+
+template <class V>
+[[gnu::always_inline]] inline V whole_step_damping(const ContactModel& m, V c_f, V inv_m_sum) {
+  return c_f / (V::splat(1.0f) + c_f * V::splat(m.half_dt) * inv_m_sum);
+}
+
+template <class V>
+[[gnu::always_inline]] inline V normal_force(const ContactModel& m, V overlap, V v_n, V c, V inv_m_sum) {
+  const V half_dt = V::splat(m.half_dt), one = V::splat(1.0f);
+  const V lead = abs(v_n) * half_dt;
+  const V reach_in = overlap + lead;
+  const V in_contact = min(max(reach_in / max(lead + lead, V::splat(kSmallestLead)), V::zero()), one);
+  const V mean_overlap = select(in_contact < one, V::splat(0.5f) * reach_in * in_contact, overlap);
+  const V c_f = c * in_contact;
+  return V::splat(m.k) * mean_overlap - whole_step_damping(m, c_f, inv_m_sum) * v_n;
+}
+
+// Lanes that start or end touching within half a step, whose force needs the
+// whole law; every other lane touches all step (overlap >= lead) or not at all.
+template <class V>
+[[gnu::always_inline]] inline auto starting_or_ending(const ContactModel& m, V overlap, V v_n) {
+  return abs(overlap) < abs(v_n) * V::splat(m.half_dt);
+}
+
+// Where every lane touches all step or not at all, the law with in_contact 1 or 0:
+// damping is whole_step_damping(c) of each lane's pair.
+template <class V>
+[[gnu::always_inline]] inline V whole_or_no_contact_force(const ContactModel& m, V overlap, V v_n, V damping) {
+  return keep(overlap > V::zero(), V::splat(m.k) * overlap - damping * v_n);
+}
+
+}  // namespace
+}  // namespace fishtank
