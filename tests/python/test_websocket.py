@@ -108,8 +108,10 @@ def test_an_over_size_message_is_refused_with_close_code_1009_before_and_after_h
             return ws.close_code
 
     assert _run(close_code([bytes(2048)])) == TOO_BIG  # a Hello is at most 1 KiB
-    assert _run(close_code([_hello(), bytes((1 << 20) + 1)])) == TOO_BIG  # a frame at most 1 MiB
-    assert "closed with code 1009" in server.text()
+    # Beyond 1 MiB the server closes with 1009 while the client is still sending: its close frame may be
+    # lost to the reset that unread bytes cause, so the server's log is what says which code it sent.
+    _run(close_code([_hello(), bytes((1 << 20) + 1)]))
+    assert server.text().count("closed with code 1009") == 2
 
 
 def test_a_text_message_or_garbage_gets_the_protocols_error_and_an_end(start_server):
