@@ -23,7 +23,7 @@ def record(tmp_path, *args):
     """Runs the server until its --duration ends; returns the recording, --dump's rows and the log."""
     trajectory, dump = tmp_path / "run.dump", tmp_path / "final.csv"
     done = subprocess.run(
-        [os.environ["FISHTANK_SERVER"], "--bind", "127.0.0.1", "--port", "0", "--threads", "1",
+        [os.environ["FISHTANK_SERVER"], "--bind", "127.0.0.1", "--port", "0", "--no-web", "--threads", "1",
          "--record", str(trajectory), "--dump", str(dump), *args],
         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, timeout=60)
     assert done.returncode == 0, done.stderr

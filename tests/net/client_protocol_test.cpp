@@ -66,3 +66,22 @@ TEST_CASE("a burst beyond --max-commands is a command flood, the same rate sprea
   CHECK(answered == 10);  // the burst allowance, then the flood
   CHECK_THAT(last.log, Catch::StartsWith("command_flood"));
 }
+
+TEST_CASE("a WebSocket message is a frame without its length prefix, under the same caps as a TCP frame", "[net]") {
+  const net::ServerInfo info;
+  net::ClientProtocol client(1, info);
+  const protocol::Frame oversize(net::kMaxFirstFrameBytes + 1, 0);
+  CHECK(client.on_unprefixed_frame(oversize.data(), oversize.size()).disconnect);  // before Hello: 1 KiB
+
+  net::ClientProtocol web(2, info);
+  const protocol::Frame hello = protocol::encode_hello("browser", true);
+  const net::Outcome joined =
+      web.on_unprefixed_frame(hello.data() + protocol::kLengthPrefixBytes, hello.size() - protocol::kLengthPrefixBytes);
+  REQUIRE(joined.command);
+  CHECK(std::holds_alternative<net::JoinCommand>(joined.command->action));
+  CHECK(web.max_body_bytes() == protocol::kMaxClientFrameBytes);
+  const protocol::Frame garbage(64, 0xAB);
+  const net::Outcome refused = web.on_unprefixed_frame(garbage.data(), garbage.size());
+  CHECK(refused.disconnect);
+  CHECK_THAT(refused.log, Catch::StartsWith("malformed_frame"));
+}
