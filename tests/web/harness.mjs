@@ -3,9 +3,10 @@
 // no browser), headless with SwiftShader's software WebGL.
 //
 // Environment: FISHTANK_SERVER (the server binary), FISHTANK_WEB_DIR (web/,
-// whose node_modules hold puppeteer-core), CHROMIUM (the browser; default chromium).
+// whose node_modules hold puppeteer-core), CHROMIUM (the browser; default: chromium on PATH).
 
 import { spawn } from 'node:child_process';
+import fs from 'node:fs';
 import { createRequire } from 'node:module';
 import path from 'node:path';
 
@@ -54,6 +55,16 @@ export function startServer(args = [], webPort = 0) {
   });
 }
 
+// puppeteer-core wants a path, not a name to look up.
+function chromium() {
+  if (process.env.CHROMIUM) return process.env.CHROMIUM;
+  for (const dir of (process.env.PATH || '').split(path.delimiter)) {
+    const candidate = path.join(dir, 'chromium');
+    if (fs.existsSync(candidate)) return candidate;
+  }
+  throw new Error('no chromium on PATH: scripts/install-deps browser installs Debian\'s, or set CHROMIUM');
+}
+
 export async function launchBrowser(width = 800, height = 600) {
   const require = createRequire(path.join(need('FISHTANK_WEB_DIR'), 'package.json'));
   const puppeteer = require('puppeteer-core');
@@ -62,7 +73,7 @@ export async function launchBrowser(width = 800, height = 600) {
   if (process.getuid?.() === 0) args.push('--no-sandbox');
   // headless: true is Chromium's new headless mode (--headless=new).
   return puppeteer.launch({
-    executablePath: process.env.CHROMIUM || 'chromium',
+    executablePath: chromium(),
     headless: true,
     args,
     defaultViewport: { width, height },

@@ -90,7 +90,7 @@ export class Hud {
     }
 
     const lines = rows.map(([label, value, fresh]) =>
-      `<div class="${fresh ? '' : 'stale'}"><span class="label">${label}</span>${escape(value)}</div>`);
+      `<div class="row${fresh ? '' : ' stale'}"><span class="label">${label}</span><span>${escape(value)}</span></div>`);
     if (v.webgl) lines.unshift(`<div class="warn">${escape(v.webgl)}</div>`);
     if (!live) lines.push(`<div class="warn" id="freshness">${escape(note)}</div>`);
     const notice = net.currentNotice();
