@@ -6,7 +6,7 @@
 //   Snapshot ─► positions(s) ─ok─► Ack(s.tick)            base kept
 //                            └ error (base unknown, corrupt) ─► Ack(want_keyframe)
 
-import { Snapshot } from 'fishtank-wire';
+import type { Snapshot } from 'fishtank-wire';
 
 // Snapshots the server may code against, at most (kKeptBases in received_snapshots.h).
 const KEPT_BASES = 32;
@@ -66,7 +66,7 @@ class BitReader {
   }
 }
 
-interface Kept {
+export interface Kept {
   tick: number;
   positions: Uint16Array;  // 3 per ball
 }
