@@ -38,6 +38,7 @@ let frameMs = 0;
 let fpsStarted = performance.now();
 let ownPlayer: Player | null = null;
 let drawnBalls = 0;
+let framesDrawn = 0;
 
 function resize(): void {
   const dpr = window.devicePixelRatio || 1;
@@ -87,6 +88,7 @@ function frame(nowMs: number): void {
   renderer?.draw(camera.viewProjection(canvas.width / Math.max(1, canvas.height)), pair, players, own, showTank);
 
   ++frames;
+  ++framesDrawn;
   const elapsed = nowMs - fpsStarted;
   if (elapsed >= 500) {
     fps = (1000 * frames) / elapsed;
@@ -115,6 +117,10 @@ requestAnimationFrame(frame);
     players: net.snapshots.newest()?.players ?? [],
     deltas: net.deltas,
     keyframeRequests: net.keyframeRequests,
+    decoded: net.decoded,
+    decodeMs: net.decodeMs,
+    framesDrawn,
+    bytes: net.bytes,
     fps,
   }),
 };

@@ -45,6 +45,9 @@ export class Connection {
   deltas = 0;
   keyframeRequests = 0;
   welcomes = 0;
+  decodeMs = 0;  // spent turning Snapshots into Frames, in all
+  decoded = 0;
+  bytes = 0;  // received, in all
   private notice = '';
   private noticeTime = 0;
   private socket: WebSocket | null = null;
@@ -87,6 +90,7 @@ export class Connection {
     socket.onmessage = (e: MessageEvent) => {
       if (socket !== this.socket || !(e.data instanceof ArrayBuffer)) return;
       this.bytesThisSecond += e.data.byteLength;
+      this.bytes += e.data.byteLength;
       const m = wire.readMessage(e.data);
       if (!m) return this.lose('the server sent something that is not a Fishtank message');
       this.handle(m);
@@ -175,6 +179,7 @@ export class Connection {
     if (!this.info) return;
     const count = s.ballCount();
     if (count > this.kinds.length) return this.lose('the server sent balls of unknown kind');
+    const started = performance.now();
     const quantised = this.received.positions(s);
     if (typeof quantised === 'string') {
       this.send(wire.ack(s.tick(), true));
@@ -213,6 +218,8 @@ export class Connection {
     const last = this.snapshots.newest();
     if (last && last.sceneStart !== f.sceneStart) this.snapshots.clear();
     this.snapshots.push(f);
+    this.decodeMs += performance.now() - started;
+    ++this.decoded;
     this.lastUpdate = f.received;
     ++this.snapshotsThisSecond;
   }
