@@ -115,6 +115,25 @@ test('the HUD says "disconnected" when the server stops, and the page reconnects
   assert.doesNotMatch(await hudText(page), /disconnected/);
 });
 
+test('where the server has no player sphere to give, the page observes, says why, and P is refused', async () => {
+  const full = await startServer(['--threads', '1', '--balls', '100', '--max-players', '0']);
+  try {
+    const p = await browser.newPage();
+    await p.goto(full.url);
+    const s = await waitForState(p, (st) => st.connection === 'connected' && st.serverBalls > 0, 'a snapshot');
+    assert.equal(s.hasPlayer, false);
+    await p.keyboard.press('KeyP');
+    await sleep(1000);
+    const hud = await hudText(p);
+    assert.match(hud, /Playerobserving: player_limit/);
+    assert.match(hud, /Controlnot yours/);
+    assert.match(hud, /not_permitted/);
+    await p.close();
+  } finally {
+    await full.stop();
+  }
+});
+
 test('the page threw no errors', () => {
   assert.deepEqual(pageErrors, []);
 });

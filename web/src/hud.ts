@@ -85,7 +85,7 @@ export class Hud {
     row('Round trip', net.rttMs >= 0 ? `${net.rttMs.toFixed(2)} ms` : '-');
     if (info) {
       row('Player', info.hasPlayer ? 'yours is the white sphere with the amber ring'
-        : v.observerAsked ? 'observing (asked for)' : 'observing (no player sphere for this page: see the note)');
+        : v.observerAsked ? 'observing, as asked (?observer)' : `observing: ${net.observing || 'the server gave no player sphere'}`);
       row('Control', controlText(info.mayControl, info.controlPolicy));
     }
 

@@ -48,6 +48,7 @@ export class Connection {
   decodeMs = 0;  // spent turning Snapshots into Frames, in all
   decoded = 0;
   bytes = 0;  // received, in all
+  observing = '';  // the server's reason when this page has no player sphere, if it gave one
   private notice = '';
   private noticeTime = 0;
   private socket: WebSocket | null = null;
@@ -120,7 +121,12 @@ export class Connection {
         return this.onSnapshot(m.payload(new Snapshot()) as Snapshot);
       case Payload.Error: {
         const e = m.payload(new WireError()) as WireError;
-        return this.say(`${ErrorCode[e.code()] ?? `error ${e.code()}`}: ${e.message() ?? ''}`);
+        const text = `${ErrorCode[e.code()] ?? `error ${e.code()}`}: ${e.message() ?? ''}`;
+        // Why this page observes stays on the HUD, not only for a notice's few seconds.
+        if (e.code() === ErrorCode.player_limit || e.code() === ErrorCode.player_idle) this.observing = text;
+        // The sphere was freed: from now on this page observes.
+        if (e.code() === ErrorCode.player_idle && this.info) this.info.hasPlayer = false;
+        return this.say(text);
       }
       case Payload.Pong: {
         const p = m.payload(new Pong()) as Pong;
@@ -154,6 +160,7 @@ export class Connection {
       controlPolicy: w.controlPolicy() ?? 'not stated by the server',
       mayControl: w.mayControl(),
     };
+    this.observing = '';
     this.kinds = new Uint8Array(0);
     this.received.clear();
     this.snapshots.clear();
