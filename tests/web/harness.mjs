@@ -68,7 +68,9 @@ function chromium() {
 export async function launchBrowser(width = 800, height = 600) {
   const require = createRequire(path.join(need('FISHTANK_WEB_DIR'), 'package.json'));
   const puppeteer = require('puppeteer-core');
-  const args = ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', `--window-size=${width},${height}`];
+  // /tmp, not /dev/shm, for shared memory: containers often give /dev/shm 64 MiB.
+  const args = ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--disable-dev-shm-usage',
+                `--window-size=${width},${height}`];
   // Chromium's sandbox refuses to start as root.
   if (process.getuid?.() === 0) args.push('--no-sandbox');
   // headless: true is Chromium's new headless mode (--headless=new).
