@@ -113,6 +113,9 @@ fishtank::net::NetOptions net_options(const fishtank::ServerOptions& o) {
   fishtank::net::NetOptions net;
   net.bind = o.bind;
   net.port = o.port;
+  net.web = o.web;
+  net.web_port = o.web_port;
+  net.web_root = o.web_root;
   net.link.snapshot_rate_hz = o.snapshot_rate;
   net.link.max_players = o.max_players;
   return net;

@@ -8,6 +8,10 @@
 #include "server/physics/worker_pool.h"
 #include "server/scenes/scene_presets.h"
 
+#ifndef FISHTANK_DEFAULT_WEB_ROOT
+#error "FISHTANK_DEFAULT_WEB_ROOT must name the folder the build puts the browser viewer's page in"
+#endif
+
 namespace fishtank {
 
 namespace po = boost::program_options;
@@ -52,12 +56,19 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "trajectory in LAMMPS dump format (OVITO, ASE, LAMMPS) while the server runs; with --bench, the final state")(
       "record-every", po::value(&record_every)->default_value(record_every), "steps between recorded frames");
 
-  std::int64_t port = o.port, max_players = o.max_players;
+  std::int64_t port = o.port, web_port = o.web_port, max_players = o.max_players;
+  bool no_web = false;
+  o.web_root = FISHTANK_DEFAULT_WEB_ROOT;
   std::string control = "players";
   po::options_description network("Network");
   network.add_options()("bind", po::value(&o.bind)->default_value(o.bind),
                         "address to listen on (127.0.0.1: this machine only; 0.0.0.0: every interface)")(
       "port", po::value(&port)->default_value(port), "TCP port (0: pick a free one and print it)")(
+      "web-port", po::value(&web_port)->default_value(web_port),
+      "port of the browser viewer: the page over HTTP and WebSocket at /ws, on the --bind address (0: pick a free "
+      "one and print it)")("no-web", po::bool_switch(&no_web), "serve no browser viewer (no HTTP/WebSocket port)")(
+      "web-root", po::value(&o.web_root)->default_value(o.web_root),
+      "folder of the browser viewer's page, served read-only")(
       "snapshot-rate", po::value(&o.snapshot_rate)->default_value(o.snapshot_rate),
       "snapshots per second sent to clients")("max-players", po::value(&max_players)->default_value(max_players),
                                               "player spheres at most; later clients observe")(
@@ -66,13 +77,17 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "everyone or nobody");
 
   net::ClientLimits& limits = o.limits;
-  std::int64_t max_connections = limits.max_connections;
+  std::int64_t max_connections = limits.max_connections, max_pending = limits.max_pending_per_address;
   std::string add_rights = "players";
   po::options_description guard(
       "Limits per client (a peer past one gets an Error saying which; a connection costs the server at most "
       "about 1.1 MiB of memory, so 64 about 72 MiB)");
-  guard.add_options()("max-connections", po::value(&max_connections)->default_value(max_connections),
-                      "clients at most; later ones get server_full and are closed")(
+  guard.add_options()(
+      "max-connections", po::value(&max_connections)->default_value(max_connections),
+      "clients at most; a newcomer evicts the oldest connection that has not said Hello, or gets server_full "
+      "when every client has")(
+      "max-pending-per-address", po::value(&max_pending)->default_value(max_pending),
+      "connections from one address that have not said Hello; a newcomer beyond it evicts the oldest of them")(
       "hello-timeout", po::value(&limits.hello_timeout_s)->default_value(limits.hello_timeout_s),
       "seconds a new connection has to send its Hello (hello_timeout)")(
       "idle-timeout", po::value(&limits.idle_timeout_s)->default_value(limits.idle_timeout_s),
@@ -165,6 +180,12 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
                 " and 100000, got " + std::to_string(steps_per_contact));
 
   if (port < 0 || port > 65535) return fail("--port must be between 0 and 65535, got " + std::to_string(port));
+  if (web_port < 0 || web_port > 65535)
+    return fail("--web-port must be between 0 and 65535, got " + std::to_string(web_port));
+  if (no_web && (!vm["web-port"].defaulted() || !vm["web-root"].defaulted()))
+    return fail("--no-web turns the web viewer off: drop --web-port and --web-root, or --no-web");
+  if (!no_web && port != 0 && port == web_port)
+    return fail("--port and --web-port are both " + std::to_string(port) + "; give them different ports");
   if (!std::isfinite(o.snapshot_rate) || o.snapshot_rate < 1.0 || o.snapshot_rate > 1000.0)
     return fail("--snapshot-rate must be between 1 and 1000 per second");
   if (max_players < 0 || max_players > 1000)
@@ -184,9 +205,14 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   const std::optional<ControlPolicy> rights = parse_control_policy(add_rights);
   if (!rights) return fail("--add-rights must be players, everyone or nobody, got '" + add_rights + "'");
   limits.add_rights = *rights;
+  if (max_pending < 1 || max_pending > 100000)
+    return fail("--max-pending-per-address must be between 1 and 100000, got " + std::to_string(max_pending));
   limits.max_connections = static_cast<std::uint32_t>(max_connections);
+  limits.max_pending_per_address = static_cast<std::uint32_t>(max_pending);
 
   o.port = static_cast<std::uint16_t>(port);
+  o.web = !no_web;
+  o.web_port = static_cast<std::uint16_t>(web_port);
   o.max_players = static_cast<std::uint32_t>(max_players);
   o.physics.steps_per_contact = static_cast<int>(steps_per_contact);
   o.threads = static_cast<int>(threads);

@@ -32,6 +32,9 @@ struct ServerOptions {
   // Network (not used by --bench, which never opens a socket).
   std::string bind = "127.0.0.1";
   std::uint16_t port = 7878;  // 0: an ephemeral port, printed at start
+  bool web = true;            // --no-web turns the browser viewer's HTTP/WebSocket port off
+  std::uint16_t web_port = 8080;
+  std::string web_root;  // default: the page as this build tree builds it
   double snapshot_rate = 60.0;
   std::uint32_t max_players = 8;
   ControlPolicy control = ControlPolicy::players;  // who may pause, step, reset, switch scene, set the time scale

@@ -15,8 +15,13 @@ namespace fishtank::net {
 using AddRights = ControlPolicy;
 
 struct ClientLimits {
-  std::uint32_t max_connections = 64;  // then server_full and a disconnect
-  double hello_timeout_s = 5.0;        // from connecting to a complete Hello; then hello_timeout
+  // Beyond it a newcomer evicts the oldest connection that has not said Hello
+  // (server_full); when every connection has, the newcomer gets server_full.
+  std::uint32_t max_connections = 64;
+  // Connections from one address that have not said Hello; a newcomer beyond it
+  // evicts the oldest of them, so a stranger's stalled connections never exceed it.
+  std::uint32_t max_pending_per_address = 8;
+  double hello_timeout_s = 5.0;  // from connecting to a complete Hello; then hello_timeout
   // A write that cannot finish for this long: the peer does not read. It gets
   // idle_timeout when it sent nothing meanwhile either, too_slow when it did.
   double idle_timeout_s = 30.0;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 #include "common/scene_names.h"
 
@@ -44,6 +45,27 @@ protocol::DecodeResult ClientProtocol::check_length_prefix(const std::uint8_t* p
             "the first frame announces " + std::to_string(*body_bytes) + " bytes; a Hello is at most " +
                 std::to_string(kMaxFirstFrameBytes)};
   return r;
+}
+
+std::uint32_t ClientProtocol::max_body_bytes() const {
+  return hello_received() ? protocol::kMaxClientFrameBytes : kMaxFirstFrameBytes;
+}
+
+Outcome ClientProtocol::on_unprefixed_frame(const std::uint8_t* body, std::size_t size, Clock::time_point now) {
+  if (size > max_body_bytes())
+    return on_broken_stream({protocol::DecodeStatus::bad_length, nullptr,
+                             "a message of " + std::to_string(size) + " bytes; at most " +
+                                 std::to_string(max_body_bytes()) + " are accepted" +
+                                 (hello_received() ? "" : " before Hello")});
+  const auto length = static_cast<std::uint32_t>(size);
+  unprefixed_.resize(protocol::kLengthPrefixBytes + size);
+  for (std::size_t i = 0; i < protocol::kLengthPrefixBytes; ++i)
+    unprefixed_[i] = static_cast<std::uint8_t>(length >> (8 * i));
+  if (size > 0) std::memcpy(unprefixed_.data() + protocol::kLengthPrefixBytes, body, size);
+  Outcome out = on_frame(unprefixed_.data(), unprefixed_.size(), now);
+  // A large message's buffer is not kept for the small ones that follow.
+  if (unprefixed_.capacity() > 16 * 1024) protocol::Frame().swap(unprefixed_);
+  return out;
 }
 
 Outcome ClientProtocol::on_frame(const std::uint8_t* frame, std::size_t size, Clock::time_point now) {
@@ -225,6 +247,10 @@ Outcome ClientProtocol::on_write_stalled(bool sent_meanwhile) {
 Outcome ClientProtocol::on_replies_piling_up(std::size_t unsent) {
   return refuse(wire::ErrorCode::too_slow,
                 "the client does not read its replies (" + std::to_string(unsent) + " unsent)", /*disconnect=*/true);
+}
+
+Outcome ClientProtocol::on_evicted(const std::string& why) {
+  return refuse(wire::ErrorCode::server_full, why, /*disconnect=*/true);
 }
 
 Outcome ClientProtocol::on_reply(const Reply& reply) {

@@ -64,6 +64,11 @@ class ClientProtocol {
   protocol::DecodeResult check_length_prefix(const std::uint8_t* prefix, std::uint32_t* body_bytes) const;
   // A complete frame, length prefix included (decoded and checked here).
   Outcome on_frame(const std::uint8_t* frame, std::size_t size, Clock::time_point now = Clock::now());
+  // A WebSocket message: a frame without its length prefix (the bytes a TCP
+  // frame has after it). It is given its prefix back and read as on_frame().
+  Outcome on_unprefixed_frame(const std::uint8_t* body, std::size_t size, Clock::time_point now = Clock::now());
+  // The most bytes the next frame's body may have: kMaxFirstFrameBytes before Hello.
+  std::uint32_t max_body_bytes() const;
   // A length prefix that check_length_prefix() refused.
   Outcome on_broken_stream(const protocol::DecodeResult& refused);
   Outcome on_reply(const Reply& reply);
@@ -78,6 +83,8 @@ class ClientProtocol {
   Outcome on_hello_timeout();
   Outcome on_write_stalled(bool sent_meanwhile);
   Outcome on_replies_piling_up(std::size_t unsent);
+  // The server needs this connection's place for a newcomer (it has not said Hello).
+  Outcome on_evicted(const std::string& why);
 
   // A Snapshot with this tick went out to the client.
   void on_snapshot_sent(std::uint32_t tick) { acks_.sent(tick); }
@@ -113,6 +120,7 @@ class ClientProtocol {
   RateBudget ack_budget_;  // twice the snapshot rate: an Ack per snapshot, and room for a late burst
   RateBudget balls_;
   AckTracker acks_;
+  protocol::Frame unprefixed_;  // on_unprefixed_frame's frame, its buffer kept for the next
 };
 
 }  // namespace fishtank::net

@@ -39,9 +39,23 @@ NetworkService::NetworkService(const NetOptions& options, ServerInfo info, RunCo
 
 std::string NetworkService::start() {
   if (std::string error = server_.listen(options_.bind, options_.port); !error.empty()) return error;
+  if (options_.web) {
+    if (std::string error = server_.listen_web(options_.bind, options_.web_port, options_.web_root); !error.empty())
+      return error;
+    if (!server_.static_files()->page_built())
+      std::fprintf(stderr,
+                   "the browser viewer's page is not built in %s: /ws works, and a browser gets a page saying "
+                   "how to build it (or use --web-root DIR)\n",
+                   options_.web_root.c_str());
+  }
   const auto endpoint = server_.local_endpoint();
-  // Tests and scripts parse this line to find an ephemeral port.
+  // Tests and scripts parse these lines to find an ephemeral port.
   std::fprintf(stderr, "listening on %s:%u\n", endpoint.address().to_string().c_str(), endpoint.port());
+  if (options_.web) {
+    const auto web = server_.web_endpoint();
+    const std::string host = web.address().is_v6() ? "[" + web.address().to_string() + "]" : web.address().to_string();
+    std::fprintf(stderr, "web viewer on http://%s:%u/\n", host.c_str(), web.port());
+  }
   std::fflush(stderr);
   io_thread_ = std::thread([this] { io_.run(); });
   return {};

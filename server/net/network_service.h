@@ -25,6 +25,9 @@ namespace fishtank::net {
 struct NetOptions {
   std::string bind = "127.0.0.1";
   std::uint16_t port = 7878;  // 0: the system picks a free port (printed by start())
+  bool web = true;            // the web viewer: HTTP and WebSocket on web_port, at the same address
+  std::uint16_t web_port = 8080;
+  std::string web_root;  // the page's folder
   PhysicsLinkOptions link;
 };
 
@@ -37,7 +40,8 @@ class NetworkService {
   // Stops the io thread; call after the physics loop has returned.
   ~NetworkService();
 
-  // Binds, prints "listening on ADDRESS:PORT" on stderr, starts the io thread.
+  // Binds, prints "listening on ADDRESS:PORT" on stderr (and "web viewer on
+  // http://ADDRESS:PORT/" unless the web side is off), starts the io thread.
   // Returns an error message, empty on success.
   std::string start();
 

@@ -6,81 +6,42 @@ namespace fishtank::net {
 
 namespace asio = boost::asio;
 
-namespace {
-// A frame's buffer starts at this and doubles as its bytes arrive.
-constexpr std::size_t kFirstChunkBytes = 4096;
-
-}  // namespace
-
-Session::Session(asio::ip::tcp::socket socket, std::uint32_t id, const ServerInfo& info, SessionOwner& owner)
-    : socket_(std::move(socket)),
-      id_(id),
+Session::Session(const asio::any_io_executor& executor, const asio::ip::tcp::endpoint& peer, std::uint32_t id,
+                 const ServerInfo& info, SessionOwner& owner)
+    : id_(id),
       owner_(owner),
       protocol_(id, info),
       limits_(info.limits),
-      watchdog_(socket_.get_executor()) {
-  boost::system::error_code ec;
-  const auto endpoint = socket_.remote_endpoint(ec);
-  peer_ = ec ? "unknown peer" : endpoint.address().to_string() + ":" + std::to_string(endpoint.port());
-  socket_.set_option(asio::ip::tcp::no_delay(true), ec);  // small replies (Pong) should not wait for Nagle
-}
+      address_(peer.address()),
+      peer_(peer.address().to_string() + ":" + std::to_string(peer.port())),
+      watchdog_(executor) {}
 
 void Session::start() {
-  spdlog::info("client {} connected from {}", id_, peer_);
-  do_read_header();
+  spdlog::info("client {} connected from {}{}", id_, peer_, transport_label());
+  start_transport();
   arm_watchdog();
 }
 
-void Session::do_read_header() {
-  asio::async_read(socket_, asio::buffer(header_),
-                   [this, self = shared_from_this()](boost::system::error_code ec, std::size_t) {
-                     if (ec) return on_error(ec, "disconnected");
-                     last_received_ = Clock::now();
-                     if (close_after_write_) return do_drain();
-                     std::uint32_t body_bytes = 0;
-                     protocol::DecodeResult length = protocol_.check_length_prefix(header_.data(), &body_bytes);
-                     if (!length.ok()) {
-                       carry_out(protocol_.on_broken_stream(length));
-                       return do_drain();
-                     }
-                     frame_bytes_ = protocol::kLengthPrefixBytes + body_bytes;
-                     incoming_.assign(header_.begin(), header_.end());
-                     do_read_body();
-                   });
+void Session::frame_received(const std::uint8_t* frame, std::size_t size) {
+  const bool had_hello = protocol_.hello_received();
+  Outcome outcome = protocol_.on_frame(frame, size, last_received_);
+  if (!had_hello && protocol_.hello_received()) owner_.session_said_hello(*this);
+  carry_out(std::move(outcome));
 }
 
-// The buffer doubles as the bytes come in, so a peer that announces a large
-// frame and stalls holds about twice what it actually sent, not what it announced.
-void Session::do_read_body() {
-  const std::size_t have = incoming_.size();
-  const std::size_t chunk = std::min(frame_bytes_ - have, std::max(have, kFirstChunkBytes));
-  incoming_.resize(have + chunk);
-  asio::async_read(socket_, asio::buffer(incoming_.data() + have, chunk),
-                   [this, self = shared_from_this()](boost::system::error_code ec, std::size_t) {
-                     if (ec) return on_error(ec, "disconnected mid-frame");
-                     last_received_ = Clock::now();
-                     if (close_after_write_) return do_drain();
-                     if (incoming_.size() < frame_bytes_) return do_read_body();
-                     carry_out(protocol_.on_frame(incoming_.data(), incoming_.size(), last_received_));
-                     // A large frame's buffer is not kept for the small ones that follow.
-                     if (incoming_.capacity() > 4 * kFirstChunkBytes) protocol::Frame().swap(incoming_);
-                     if (closed_) return;
-                     if (close_after_write_) return do_drain();
-                     do_read_header();
-                   });
+void Session::message_received(const std::uint8_t* body, std::size_t size) {
+  const bool had_hello = protocol_.hello_received();
+  Outcome outcome = protocol_.on_unprefixed_frame(body, size, last_received_);
+  if (!had_hello && protocol_.hello_received()) owner_.session_said_hello(*this);
+  carry_out(std::move(outcome));
 }
 
-// A session that is ending reads and drops what the peer still sends: closing
-// with unread bytes would reset the connection, and the peer could lose the
-// Error that says why. The peer's close, or the grace period, ends it.
-void Session::do_drain() {
+void Session::stream_broken(const protocol::DecodeResult& refused) { carry_out(protocol_.on_broken_stream(refused)); }
+
+void Session::read_on() {
   if (closed_) return;
-  incoming_.resize(kFirstChunkBytes);
-  socket_.async_read_some(asio::buffer(incoming_),
-                          [this, self = shared_from_this()](boost::system::error_code ec, std::size_t) {
-                            if (ec) return on_error(ec, "disconnected by the server");
-                            do_drain();
-                          });
+  if (close_after_write_) return do_drain();
+  do_read();
 }
 
 void Session::carry_out(Outcome outcome) {
@@ -116,8 +77,15 @@ void Session::deliver(const Reply& reply) {
   carry_out(std::move(outcome));
 }
 
+void Session::evict(const std::string& why) { carry_out(protocol_.on_evicted(why)); }
+
 void Session::do_write() {
   if (write_in_flight_ || closed_) return;
+  if (!carries_frames()) {
+    // Only a connection that has not said Hello cannot carry frames: it has no one to tell why.
+    if (close_after_write_) close("disconnected by the server before it upgraded to a WebSocket");
+    return;
+  }
   std::vector<asio::const_buffer> buffers;
   writing_replies_.assign(std::make_move_iterator(replies_.begin()), std::make_move_iterator(replies_.end()));
   replies_.clear();
@@ -142,24 +110,25 @@ void Session::do_write() {
   }
   if (buffers.empty()) {
     if (close_after_write_ && !farewell_sent_) {
-      // Everything is sent: a FIN follows it, and do_drain() waits for the peer's.
+      // Everything is sent: the farewell follows it, and do_drain() waits for the peer's.
       farewell_sent_ = true;
-      boost::system::error_code ignored;
-      socket_.shutdown(asio::ip::tcp::socket::shutdown_send, ignored);
+      send_farewell();
     }
     return;
   }
   write_in_flight_ = true;
   write_started_ = Clock::now();
-  asio::async_write(socket_, buffers, [this, self = shared_from_this()](boost::system::error_code ec, std::size_t n) {
-    write_in_flight_ = false;
-    writing_replies_.clear();
-    writing_kinds_.clear();
-    writing_snapshot_.reset();
-    if (ec) return on_error(ec, "disconnected");
-    owner_.bytes_sent(n);
-    do_write();
-  });
+  write_frames(std::move(buffers));
+}
+
+void Session::frames_written(const boost::system::error_code& ec, std::size_t bytes) {
+  write_in_flight_ = false;
+  writing_replies_.clear();
+  writing_kinds_.clear();
+  writing_snapshot_.reset();
+  if (ec) return on_error(ec, "disconnected");
+  owner_.bytes_sent(bytes);
+  do_write();
 }
 
 void Session::arm_watchdog() {
@@ -200,7 +169,7 @@ void Session::check_limits() {
 }
 
 void Session::on_error(const boost::system::error_code& ec, const char* on_eof) {
-  if (ec == asio::error::operation_aborted) return;  // we closed the socket ourselves: not an error
+  if (ec == asio::error::operation_aborted) return;  // we closed the connection ourselves: not an error
   // Compared by value and category, without building a misc_errors error_code: that calls into
   // Boost's category object, which UBSan caught mid-construction or mid-destruction at exit.
   const bool eof = ec.value() == asio::error::eof && ec.category() == asio::error::get_misc_category();
@@ -211,9 +180,7 @@ void Session::close(const std::string& reason) {
   if (closed_) return;
   closed_ = true;
   watchdog_.cancel();
-  boost::system::error_code ignored;
-  socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
-  socket_.close(ignored);
+  close_transport();
   spdlog::info("client {} ('{}') closed: {}", id_, protocol_.client_name(), reason);
   owner_.session_closed(*this);
 }

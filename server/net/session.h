@@ -1,10 +1,13 @@
 #pragma once
-// One client connection (Asio-example style: do_* functions start async work,
-// handlers capture [this, self], operation_aborted is a normal end).
+// One client connection, whatever carries it (Asio-example style: do_*
+// functions start async work, handlers capture [this, self], operation_aborted
+// is a normal end). This class is the conversation and its limits; the
+// transport is a subclass: TcpSession (length-prefixed frames on a socket) or
+// WebSession (HTTP, then one frame per WebSocket message after the /ws upgrade).
 //
-//   reads:  [4-byte length] ─check cap─► [body, its buffer growing as bytes arrive]
+//   reads (the transport): one read always pending ─► a complete frame
 //             ─► ClientProtocol ─► replies / commands
-//   writes: one async_write in flight; behind it
+//   writes: one write in flight (the transport's); behind it
 //             replies          a short queue (bounded: a client that does not read is dropped)
 //             newest snapshot  one slot, overwritten by each new snapshot
 //   watchdog: one timer, set to the nearest of the Hello deadline, the in-flight
@@ -19,7 +22,6 @@
 // before Hello, then at most about twice the bytes of the frame being received
 // (at most kMaxClientFrameBytes), plus at most kMaxQueuedReplies small replies.
 
-#include <array>
 #include <boost/asio.hpp>
 #include <chrono>
 #include <cstdint>
@@ -41,6 +43,7 @@ class SessionOwner {
  public:
   virtual ~SessionOwner() = default;
   virtual bool submit(Command command) = 0;  // false when the command queue is full
+  virtual void session_said_hello(Session& session) = 0;
   virtual void session_welcomed(Session& session) = 0;
   virtual void session_closed(Session& session) = 0;
   virtual void bytes_sent(std::size_t bytes) = 0;
@@ -57,38 +60,77 @@ class Session : public std::enable_shared_from_this<Session> {
   // How long a session that is ending waits for its last Error to be read.
   static constexpr auto kErrorGrace = std::chrono::seconds(2);
 
-  Session(boost::asio::ip::tcp::socket socket, std::uint32_t id, const ServerInfo& info, SessionOwner& owner);
+  Session(const boost::asio::any_io_executor& executor, const boost::asio::ip::tcp::endpoint& peer, std::uint32_t id,
+          const ServerInfo& info, SessionOwner& owner);
+  virtual ~Session() = default;
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
 
   void start();
   void offer_snapshot(SharedSnapshot snapshot);
   void deliver(const Reply& reply);
+  // Error(server_full) saying why, then the usual end: the server needs the place.
+  void evict(const std::string& why);
   void close(const std::string& reason);
 
   std::uint32_t id() const { return id_; }
   bool welcomed() const { return protocol_.welcomed(); }
+  bool hello_received() const { return protocol_.hello_received(); }
+  const boost::asio::ip::address& address() const { return address_; }
+
+ protected:
+  // For the transports, from their read handlers.
+  void received_bytes() { last_received_ = Clock::now(); }
+  void frame_received(const std::uint8_t* frame, std::size_t size);   // length prefix included
+  void message_received(const std::uint8_t* body, std::size_t size);  // a WebSocket message: no prefix
+  void stream_broken(const protocol::DecodeResult& refused);
+  // After a frame: the next read, the drain of an ending session, or nothing once closed.
+  void read_on();
+  // The write started by write_frames() is done.
+  void frames_written(const boost::system::error_code& ec, std::size_t bytes);
+  // A failed read or write: the peer left, or the connection broke.
+  void on_error(const boost::system::error_code& ec, const char* on_eof);
+  // Sends what waits, e.g. once the transport carries frames.
+  void do_write();
+  bool ending() const { return close_after_write_; }
+  bool closed() const { return closed_; }
+  // A TCP frame's length prefix, checked against the cap that applies now.
+  protocol::DecodeResult check_length_prefix(const std::uint8_t* prefix, std::uint32_t* body_bytes) const {
+    return protocol_.check_length_prefix(prefix, body_bytes);
+  }
+  // The largest WebSocket message that may come next.
+  std::uint32_t max_body_bytes() const { return protocol_.max_body_bytes(); }
+  const std::string& peer() const { return peer_; }
 
  private:
-  void do_read_header();
-  void do_read_body();
-  void do_drain();
+  // ---- the transport ----
+  // Starts reading; for a web connection, HTTP requests until the upgrade.
+  virtual void start_transport() = 0;
+  // Reads the next frame, then frame_received() / message_received() and read_on().
+  virtual void do_read() = 0;
+  // Reads and drops what the peer still sends, until it closes.
+  virtual void do_drain() = 0;
+  // False while the connection cannot carry frames (a web connection before the upgrade).
+  virtual bool carries_frames() const = 0;
+  // Sends these complete frames (length prefix included), then frames_written().
+  virtual void write_frames(std::vector<boost::asio::const_buffer> frames) = 0;
+  // Every reply of an ending session is out: say so to the peer (TCP: FIN; WebSocket: a close frame).
+  virtual void send_farewell() = 0;
+  virtual void close_transport() = 0;
+  // How the connection came, for the log: "" for TCP.
+  virtual const char* transport_label() const = 0;
+
   void carry_out(Outcome outcome);
-  void do_write();
   void arm_watchdog();
   Clock::time_point next_check(Clock::time_point now) const;
   void check_limits();
-  // A failed read or write: the peer left, or the socket broke.
-  void on_error(const boost::system::error_code& ec, const char* on_eof);
 
-  boost::asio::ip::tcp::socket socket_;
   std::uint32_t id_;
   SessionOwner& owner_;
   ClientProtocol protocol_;
   const ClientLimits& limits_;
+  boost::asio::ip::address address_;
   std::string peer_;
-
-  std::array<std::uint8_t, protocol::kLengthPrefixBytes> header_{};
-  protocol::Frame incoming_;     // the frame being received, grown as its bytes arrive
-  std::size_t frame_bytes_ = 0;  // its full size, length prefix included
 
   boost::asio::steady_timer watchdog_;
   Clock::time_point connected_at_ = Clock::now();

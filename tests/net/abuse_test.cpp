@@ -172,28 +172,129 @@ TEST_CASE("abuse: 500 peers say Hello, announce 1 MiB, send one byte and stall -
   CHECK(rate >= kHonestRate);
 }
 
-TEST_CASE("abuse: connections beyond --max-connections get server_full and are closed, and room frees up", "[abuse]") {
-  ServerProcess server({"--balls", "300", "--max-connections", "20", "--hello-timeout", "30"});
+TEST_CASE("abuse: when every place belongs to a client past Hello, newcomers get server_full and those clients stay",
+          "[abuse]") {
+  ServerProcess server({"--balls", "300", "--max-connections", "6", "--hello-timeout", "30"});
   auto honest = honest_viewer(server);
-  std::vector<std::unique_ptr<RawSocket>> holders;
+  std::vector<std::unique_ptr<BackgroundClient>> watchers;
+  for (int i = 0; i < 5; ++i) watchers.push_back(std::make_unique<BackgroundClient>(server.port(), false, "watcher"));
+  for (auto& watcher : watchers) REQUIRE(watcher->wait_until([](const ClientState& s) { return s.snapshots > 0; }, 5s));
   int refused = 0;
+  const Clock::time_point start = Clock::now();
   const double rate = snapshot_rate(*honest, [&] {
-    for (int i = 0; i < 19; ++i) holders.push_back(std::make_unique<RawSocket>(server.port()));
-    std::this_thread::sleep_for(300ms);  // all accepted: the server is full
     for (int i = 0; i < 30; ++i) {
       RawSocket late(server.port());
       std::vector<std::uint8_t> got;
       refused += late.read_until_closed(got, 3s) && first_error_code(got) == "server_full";
     }
+    std::this_thread::sleep_until(start + 1s);  // a window long enough to measure the honest rate in
   });
-  holders.clear();
+  int stayed = 0;
+  for (auto& watcher : watchers) stayed += !watcher->state().closed && watcher->state().snapshots > 30;
+  watchers.pop_back();
+  wait_for_log(server, "('watcher') closed", 5s);  // its place is free only once the server saw it leave
   BackgroundClient newcomer(server.port(), false, "newcomer");
   const bool admitted = newcomer.wait_until([](const ClientState& s) { return s.welcomed; }, 5s);
-  record("19 silent connections fill the server, 30 more arrive", "--max-connections 20",
-         std::to_string(refused) + " of 30 got server_full; a newcomer was welcomed once they left", rate);
+  record("6 observers past Hello fill --max-connections 6, 30 more arrive", "sessions past Hello are never evicted",
+         std::to_string(refused) + " of 30 got server_full; " + std::to_string(stayed) +
+             " of 5 observers kept watching; a newcomer was welcomed once one left",
+         rate);
   CHECK(refused == 30);
+  CHECK(stayed == 5);
   CHECK(admitted);
   CHECK(rate >= kHonestRate);
+}
+
+TEST_CASE("abuse: a newcomer to a table full of connections without Hello evicts the oldest, which gets server_full",
+          "[abuse]") {
+  ServerProcess server(
+      {"--balls", "300", "--max-connections", "10", "--max-pending-per-address", "100", "--hello-timeout", "30"});
+  auto honest = honest_viewer(server);
+  std::vector<std::unique_ptr<RawSocket>> silent;
+  for (int i = 0; i < 9; ++i) silent.push_back(std::make_unique<RawSocket>(server.port()));
+  std::this_thread::sleep_for(300ms);  // all accepted: the table is full
+  BackgroundClient newcomer(server.port(), false, "newcomer");
+  CHECK(newcomer.wait_until([](const ClientState& s) { return s.welcomed; }, 5s));
+  std::vector<std::uint8_t> oldest, next;
+  CHECK(silent.front()->read_until_closed(oldest, 3s));
+  CHECK(first_error_code(oldest) == "server_full");
+  CHECK_FALSE(silent[1]->read_until_closed(next, 300ms));  // the others keep their places
+  CHECK_FALSE(honest->state().closed);
+}
+
+TEST_CASE("abuse: an address's connections without Hello are capped: beyond it the oldest of them is evicted",
+          "[abuse]") {
+  ServerProcess server({"--balls", "300", "--max-pending-per-address", "3", "--hello-timeout", "30"});
+  std::vector<std::unique_ptr<RawSocket>> silent;
+  for (int i = 0; i < 5; ++i) {
+    silent.push_back(std::make_unique<RawSocket>(server.port()));
+    std::this_thread::sleep_for(50ms);  // accepted in this order
+  }
+  int evicted = 0, kept = 0;
+  for (int i = 0; i < 5; ++i) {
+    std::vector<std::uint8_t> got;
+    const bool closed = silent[i]->read_until_closed(got, i < 2 ? 3000ms : 300ms);
+    evicted += i < 2 && closed && first_error_code(got) == "server_full";
+    kept += i >= 2 && !closed;
+  }
+  CHECK(evicted == 2);
+  CHECK(kept == 3);
+  CHECK_THAT(server.log(), Catch::Contains("--max-pending-per-address"));
+}
+
+namespace {
+
+// The issue's target: 300 peers announce a 1 MiB frame before Hello and stall,
+// 5 connect and stay silent; then an honest observer connects. It must be
+// welcomed within 1 s and get >= 45 snapshots a second over the next second,
+// and the server's RSS must grow by less than 64 MiB. With `web`, the peers
+// come over the web port: the stalled ones upgrade at /ws first.
+void check_observer_among_stalled_peers(bool web) {
+  ServerProcess server({"--balls", "300", "--web-port", "0"});
+  const std::uint16_t port = web ? server.web_port() : server.port();
+  const long rss_before = server.rss_kb();
+  std::vector<std::unique_ptr<RawSocket>> peers;
+  int upgraded = 0;
+  for (int i = 0; i < 300; ++i) {
+    peers.push_back(std::make_unique<RawSocket>(port, /*receive_buffer=*/4096));
+    if (web) {
+      peers.back()->send_text(websocket_upgrade_request());
+      std::vector<std::uint8_t> response;
+      upgraded += peers.back()->read_until("\r\n\r\n", response, 2s);
+      std::vector<std::uint8_t> announce = websocket_frame_header(protocol::kMaxClientFrameBytes);
+      announce.push_back(0x00);
+      peers.back()->send(announce);
+    } else {
+      peers.back()->send(frame_with_length(protocol::kMaxClientFrameBytes, 1));
+    }
+  }
+  for (int i = 0; i < 5; ++i) peers.push_back(std::make_unique<RawSocket>(port));
+  const Clock::time_point connected = Clock::now();
+  BackgroundClient observer(server.port(), false, "observer");
+  const bool welcomed = observer.wait_until([](const ClientState& s) { return s.welcomed; }, 1s);
+  const double welcome_s = seconds_since(connected);
+  const double rate = snapshot_rate(observer, [] { std::this_thread::sleep_for(1s); });
+  const long growth = rss_growth_kb(server, rss_before);
+  const std::string peers_text = web ? "over WebSocket (" + std::to_string(upgraded) + " upgraded at /ws)" : "over TCP";
+  record("300 peers announce a 1 MiB frame before Hello and stall, 5 stay silent, " + peers_text +
+             "; then an observer connects",
+         "evict the oldest without Hello; --max-pending-per-address 8",
+         "observer welcomed after " + fixed(welcome_s, "s") + "; RSS +" + fixed(growth / 1024.0, "MiB"), rate);
+  INFO("observer welcomed after " << welcome_s << " s");
+  CHECK(welcomed);
+  if (web) CHECK(upgraded == 300);
+  check_rss_growth(growth, 64 * 1024);
+  CHECK(rate >= kHonestRate);
+}
+
+}  // namespace
+
+TEST_CASE("abuse: 300 stalled and 5 silent strangers before Hello cannot keep an observer out (TCP)", "[abuse]") {
+  check_observer_among_stalled_peers(/*web=*/false);
+}
+
+TEST_CASE("abuse: 300 stalled and 5 silent strangers before Hello cannot keep an observer out (WebSocket)", "[abuse]") {
+  check_observer_among_stalled_peers(/*web=*/true);
 }
 
 TEST_CASE("abuse: a Hello sent one byte at a time is cut off at the Hello deadline with hello_timeout", "[abuse]") {

@@ -45,6 +45,9 @@ ServerProcess::ServerProcess(const std::vector<std::string>& args, const std::ve
   // The server refuses a flag given twice.
   if (std::find(args.begin(), args.end(), "--threads") == args.end())
     argv_text.insert(argv_text.end(), {"--threads", "1"});
+  // Tests run side by side: none may take the default web port.
+  const bool web = std::find(args.begin(), args.end(), "--web-port") != args.end();
+  if (!web) argv_text.push_back("--no-web");
   argv_text.insert(argv_text.end(), args.begin(), args.end());
   argv_text.insert(argv_text.begin(), launcher.begin(), launcher.end());
   std::vector<char*> argv;
@@ -60,12 +63,14 @@ ServerProcess::ServerProcess(const std::vector<std::string>& args, const std::ve
   if (spawned != 0) throw std::runtime_error("cannot start " + argv_text[0]);
 
   const std::regex listening("listening on 127\\.0\\.0\\.1:([0-9]+)");
+  const std::regex web_viewer("web viewer on http://127\\.0\\.0\\.1:([0-9]+)/");
   const Clock::time_point deadline = Clock::now() + std::chrono::seconds(15);
   while (Clock::now() < deadline && running()) {
-    std::smatch m;
+    std::smatch m, w;
     const std::string text = log();
-    if (std::regex_search(text, m, listening)) {
+    if (std::regex_search(text, m, listening) && (!web || std::regex_search(text, w, web_viewer))) {
       port_ = static_cast<std::uint16_t>(std::stoi(m[1]));
+      if (web) web_port_ = static_cast<std::uint16_t>(std::stoi(w[1]));
       return;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -159,6 +164,21 @@ bool RawSocket::read_until_closed(std::vector<std::uint8_t>& out, std::chrono::m
     out.insert(out.end(), buffer, buffer + n);
   }
   return false;
+}
+
+bool RawSocket::read_until(const std::string& text, std::vector<std::uint8_t>& out, std::chrono::milliseconds timeout) {
+  const Clock::time_point deadline = Clock::now() + timeout;
+  std::uint8_t buffer[4096];
+  while (std::search(out.begin(), out.end(), text.begin(), text.end()) == out.end()) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+    if (left.count() <= 0) return false;
+    pollfd p{fd_, POLLIN, 0};
+    if (poll(&p, 1, static_cast<int>(left.count())) <= 0) continue;
+    const ssize_t n = recv(fd_, buffer, sizeof buffer, 0);
+    if (n <= 0) return false;
+    out.insert(out.end(), buffer, buffer + n);
+  }
+  return true;
 }
 
 void RawSocket::close() {

@@ -1,4 +1,6 @@
-"""A real fishtank-server on an ephemeral 127.0.0.1 port for each test (FISHTANK_SERVER names the executable)."""
+"""A real fishtank-server on an ephemeral 127.0.0.1 port for each test (FISHTANK_SERVER names the executable).
+Its web viewer is off unless the test gives --web-port (0: an ephemeral port too, then in web_port), so that
+servers started side by side never contend for the default port 8080."""
 
 import os
 import re
@@ -13,14 +15,20 @@ import pytest
 class Server:
     def __init__(self, *args):
         self.log = tempfile.NamedTemporaryFile(prefix="fishtank-server-", suffix=".log", delete=False)
+        web = "--web-port" in args
         self.process = subprocess.Popen(
-            [os.environ["FISHTANK_SERVER"], "--bind", "127.0.0.1", "--port", "0", "--threads", "1", *args],
+            [os.environ["FISHTANK_SERVER"], "--bind", "127.0.0.1", "--port", "0", "--threads", "1",
+             *([] if web else ["--no-web"]), *args],
             stderr=self.log, stdout=subprocess.DEVNULL)
+        self.web_port = None
         deadline = time.monotonic() + 15
         while time.monotonic() < deadline:
-            found = re.search(r"listening on 127\.0\.0\.1:(\d+)", self.text())
-            if found:
+            text = self.text()
+            found = re.search(r"listening on 127\.0\.0\.1:(\d+)", text)
+            found_web = re.search(r"web viewer on http://127\.0\.0\.1:(\d+)/", text)
+            if found and (found_web or not web):
                 self.port = int(found.group(1))
+                self.web_port = int(found_web.group(1)) if web else None
                 return
             if self.process.poll() is not None:
                 break

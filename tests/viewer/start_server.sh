@@ -4,7 +4,7 @@
 start_server() {
   local log=$1
   shift
-  "$server" --port 0 "$@" 2>"$log" &
+  "$server" --port 0 --no-web "$@" 2>"$log" &
   server_pid=$!
   trap 'kill "$server_pid" 2>/dev/null || true; wait "$server_pid" 2>/dev/null || true' EXIT
   port=""

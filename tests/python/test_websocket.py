@@ -1,0 +1,198 @@
+"""The server's web side from outside, as a browser would meet it: the protocol over a WebSocket
+at /ws (one frame per binary message, without the length prefix) with its Welcome, snapshots,
+Acks and deltas; the WebSocket's size limit (close code 1009); and the static files, served
+read-only from one folder: paths out of it get 404, methods other than GET and HEAD get 405,
+an over-size header gets 431. Frames are built and read with the Python client's FlatBuffers code."""
+
+import asyncio
+import http.client
+import os
+
+import pytest
+import websockets
+
+from fishtank.client import _frame
+from fishtank._protocol import PROTOCOL_VERSION
+from fishtank.wire import Ack, Hello, Message, Payload, Snapshot
+
+TOO_BIG = 1009  # RFC 6455: message too big
+
+
+def _body(payload_type, build):
+    """A frame as the WebSocket carries it: the TCP frame without its 4-byte length prefix."""
+    return _frame(payload_type, build)[4:]
+
+
+def _hello(name="websocket test"):
+    def build(b):
+        text = b.CreateString(name)
+        Hello.Start(b)
+        Hello.AddProtocolVersion(b, PROTOCOL_VERSION)
+        Hello.AddClientName(b, text)
+        return Hello.End(b)
+
+    return _body(Payload.Payload.Hello, build)
+
+
+def _ack(tick):
+    def build(b):
+        Ack.Start(b)
+        Ack.AddTick(b, tick)
+        return Ack.End(b)
+
+    return _body(Payload.Payload.Ack, build)
+
+
+def _message(body):
+    assert isinstance(body, bytes), "the server sends binary messages only"
+    assert body[4:8] == b"FTNK", "each message is one frame without its length prefix"
+    return Message.Message.GetRootAs(body, 0)
+
+
+def _snapshot(m):
+    s = Snapshot.Snapshot()
+    s.Init(m.Payload().Bytes, m.Payload().Pos)
+    return s
+
+
+def _connect(port, **options):
+    return websockets.connect(f"ws://127.0.0.1:{port}/ws", compression=None, max_size=None, **options)
+
+
+def _run(coroutine):
+    return asyncio.run(asyncio.wait_for(coroutine, timeout=20))
+
+
+def test_over_a_websocket_a_client_is_welcomed_and_gets_deltas_once_it_acknowledges(start_server):
+    server = start_server("--balls", "300", "--web-port", "0")
+
+    async def converse():
+        async with _connect(server.web_port) as ws:
+            await ws.send(_hello())
+            kinds = []
+            while True:
+                m = _message(await ws.recv())
+                kinds.append(m.PayloadType())
+                if m.PayloadType() == Payload.Payload.Snapshot:
+                    first = _snapshot(m)
+                    break
+            assert kinds[0] == Payload.Payload.Welcome and Payload.Payload.BallKinds in kinds
+            assert first.BallCount() > 0 and first.PositionsLength() == 3 * first.BallCount()  # a keyframe: all
+            await ws.send(_ack(first.Tick()))
+            for _ in range(60):
+                m = _message(await ws.recv())
+                if m.PayloadType() != Payload.Payload.Snapshot:
+                    continue
+                s = _snapshot(m)
+                if s.UnchangedLength() > 0:
+                    return first.Tick(), s
+            return first.Tick(), None
+
+    acked, delta = _run(converse())
+    assert delta is not None, "no delta within 60 snapshots of the Ack"
+    assert delta.PositionsLength() == 0 and delta.BaseTick() == acked and delta.BallCount() > 0
+    assert "upgraded to a WebSocket" in server.text()
+
+
+def test_an_over_size_message_is_refused_with_close_code_1009_before_and_after_hello(start_server):
+    server = start_server("--balls", "50", "--web-port", "0")
+
+    async def close_code(messages):
+        async with _connect(server.web_port) as ws:
+            for message in messages:
+                await ws.send(message)
+            with pytest.raises(websockets.ConnectionClosed):
+                while True:
+                    await ws.recv()
+            return ws.close_code
+
+    assert _run(close_code([bytes(2048)])) == TOO_BIG  # a Hello is at most 1 KiB
+    assert _run(close_code([_hello(), bytes((1 << 20) + 1)])) == TOO_BIG  # a frame at most 1 MiB
+    assert "closed with code 1009" in server.text()
+
+
+def test_a_text_message_or_garbage_gets_the_protocols_error_and_an_end(start_server):
+    server = start_server("--balls", "50", "--web-port", "0")
+
+    async def refusal(message):
+        async with _connect(server.web_port) as ws:
+            await ws.send(message)
+            received = []
+            with pytest.raises(websockets.ConnectionClosed):
+                while True:
+                    received.append(_message(await ws.recv()))
+            return [m.PayloadType() for m in received]
+
+    assert _run(refusal("hello")) == [Payload.Payload.Error]
+    assert _run(refusal(bytes(range(64)))) == [Payload.Payload.Error]
+    assert "malformed_frame" in server.text()
+
+
+@pytest.fixture
+def web_root(tmp_path):
+    """A page folder with a file, a subfolder, and a symlink and a file beside it that lead out of it."""
+    root = tmp_path / "root"
+    (root / "sub").mkdir(parents=True)
+    (root / "index.html").write_text("<title>fishtank</title>")
+    (root / "sub" / "app.js").write_text("console.log(1);")
+    secret = tmp_path / "secret.txt"
+    secret.write_text("not for the web")
+    os.symlink(secret, root / "sub" / "link.txt")
+    os.symlink(tmp_path, root / "up")
+    return root
+
+
+def _request(port, method, path, headers=None):
+    connection = http.client.HTTPConnection("127.0.0.1", port, timeout=10)
+    connection.putrequest(method, path, skip_host=True, skip_accept_encoding=True)
+    connection.putheader("Host", "127.0.0.1")
+    for name, value in (headers or {}).items():
+        connection.putheader(name, value)
+    connection.endheaders()
+    response = connection.getresponse()
+    body = response.read()
+    connection.close()
+    return response.status, dict(response.getheaders()), body
+
+
+def test_files_are_served_from_the_web_root_and_nothing_outside_it(start_server, web_root):
+    server = start_server("--balls", "0", "--web-port", "0", "--web-root", str(web_root))
+    port = server.web_port
+    status, headers, body = _request(port, "GET", "/")
+    assert status == 200 and body == b"<title>fishtank</title>" and headers["Content-Type"].startswith("text/html")
+    status, headers, body = _request(port, "GET", "/sub/app.js?v=2")
+    assert status == 200 and body == b"console.log(1);" and headers["Content-Type"].startswith("text/javascript")
+    status, headers, body = _request(port, "HEAD", "/sub/app.js")
+    assert status == 200 and headers["Content-Length"] == "15" and body == b""
+    for outside in ("/../secret.txt", "/sub/../../secret.txt", "/%2e%2e/secret.txt", "/%2E%2E%2Fsecret.txt",
+                    "/sub/%2e%2e%2f%2e%2e%2fsecret.txt", "/sub/link.txt", "/up/secret.txt", "/nothing.js",
+                    "/%zz", "/sub%00/app.js"):
+        status, _, body = _request(port, "GET", outside)
+        assert status == 404, outside
+        assert b"not for the web" not in body
+
+
+def test_other_methods_get_405_upgrades_elsewhere_404_and_an_over_size_header_431(start_server, web_root):
+    server = start_server("--balls", "0", "--web-port", "0", "--web-root", str(web_root))
+    port = server.web_port
+    for method in ("POST", "PUT", "DELETE", "OPTIONS"):
+        status, headers, _ = _request(port, method, "/index.html")
+        assert status == 405 and headers["Allow"] == "GET, HEAD", method
+    upgrade = {"Upgrade": "websocket", "Connection": "Upgrade", "Sec-WebSocket-Version": "13",
+               "Sec-WebSocket-Key": "dGhlIHNhbXBsZSBub25jZQ=="}
+    assert _request(port, "GET", "/index.html", upgrade)[0] == 404
+    assert _request(port, "GET", "/ws", {"X-Filler": "a" * 20000})[0] == 431
+
+
+def test_without_a_built_page_the_server_says_how_to_build_it_and_ws_still_works(start_server, tmp_path):
+    server = start_server("--balls", "10", "--web-port", "0", "--web-root", str(tmp_path / "missing"))
+    status, _, body = _request(server.web_port, "GET", "/")
+    assert status == 404 and b"not built" in body and b"--web-root" in body
+    assert "not built" in server.text()
+
+    async def welcomed():
+        async with _connect(server.web_port) as ws:
+            await ws.send(_hello())
+            return _message(await ws.recv()).PayloadType()
+
+    assert _run(welcomed()) == Payload.Payload.Welcome
