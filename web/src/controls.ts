@@ -65,6 +65,7 @@ export class Input {
 
   constructor(canvas: HTMLCanvasElement) {
     window.addEventListener('keydown', (e) => {
+      if (e.ctrlKey || e.metaKey || e.altKey) return;  // the browser's shortcuts (Ctrl+R reloads, not resets)
       this.held.add(e.code);
       if (!e.repeat && this.press(e.code)) e.preventDefault();
     });

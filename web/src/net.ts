@@ -84,7 +84,13 @@ export class Connection {
 
   private connect(): void {
     this.state = 'connecting';
-    const socket = new WebSocket(this.url);
+    let socket: WebSocket;
+    try {
+      socket = new WebSocket(this.url);
+    } catch (error) {
+      this.state = 'disconnected';
+      return this.say(`cannot connect to ${this.url}: ${error}`);  // a malformed ?ws= address: retrying cannot help
+    }
     socket.binaryType = 'arraybuffer';
     this.socket = socket;
     socket.onopen = () => socket.send(wire.hello(this.name, this.wantsPlayer));
@@ -94,7 +100,12 @@ export class Connection {
       this.bytes += e.data.byteLength;
       const m = wire.readMessage(e.data);
       if (!m) return this.lose('the server sent something that is not a Fishtank message');
-      this.handle(m);
+      // JavaScript's FlatBuffers has no verifier: a damaged message throws while it is read.
+      try {
+        this.handle(m);
+      } catch (error) {
+        this.lose(`the server sent a message the page cannot read (${error}); reconnecting`);
+      }
     };
     socket.onclose = (e: CloseEvent) => {
       if (socket !== this.socket) return;
