@@ -1,15 +1,19 @@
 // libFuzzer target: arbitrary bytes as a client's byte stream to the server,
-// and as a server's byte stream to a client.
+// as a WebSocket client's messages to the server, and as a server's byte
+// stream to a client.
 //
 //   bytes ─► FrameReader(to_server) ─► ClientProtocol::on_frame ─► replies, commands
 //        │                                 └ on_reply(Joined / BallsAdded) after a Join,
 //        │                                   then snapshots sent (some skipped), so Acks count
+//        ├─► messages of one chunk each ─► ClientProtocol::on_unprefixed_frame (the
+//        │                                 WebSocket path: frames without length prefix) ─► the same
 //        └─► FrameReader(to_client) ─► every field a client reads, and the positions
 //                                      of every Snapshot (deltas against the ones before)
 //
 // The first byte picks the chunk size the stream is cut into, so frame
-// boundaries land everywhere. A crash, a sanitizer report or an accepted frame
-// that fails to decode again is a bug.
+// boundaries land everywhere (and the WebSocket messages have every size up to
+// past the 1 KiB allowed before Hello). A crash, a sanitizer report or an
+// accepted frame that fails to decode again is a bug.
 
 #include <cstddef>
 #include <cstdint>
@@ -31,6 +35,21 @@ void check(bool ok) {
   if (!ok) std::abort();
 }
 
+// What the server does with an outcome, checked; false once the conversation is over.
+bool carry_out(net::ClientProtocol& conversation, const net::Outcome& outcome) {
+  for (const protocol::Frame& reply : outcome.replies)  // everything the server says must decode
+    check(protocol::decode_frame(reply.data(), reply.size(), protocol::Direction::to_client).ok());
+  if (outcome.command && std::holds_alternative<net::JoinCommand>(outcome.command->action)) {
+    net::Reply joined{1, net::JoinedReply{std::nullopt, "all player spheres are taken"}};
+    for (const protocol::Frame& reply : conversation.on_reply(joined).replies)
+      check(protocol::decode_frame(reply.data(), reply.size(), protocol::Direction::to_client).ok());
+    // Ticks 0 .. 39 sent, every fifth skipped: acks may be good, skipped, too old or in the future.
+    for (std::uint32_t tick = 0; tick < 40; ++tick)
+      if (tick % 5 != 4) conversation.on_snapshot_sent(tick);
+  }
+  return !outcome.disconnect;
+}
+
 void drive_server(const std::uint8_t* data, std::size_t size, std::size_t chunk) {
   protocol::FrameReader reader(protocol::Direction::to_server);
   net::ClientProtocol conversation(1, kInfo);
@@ -39,21 +58,21 @@ void drive_server(const std::uint8_t* data, std::size_t size, std::size_t chunk)
     while (auto decoded = reader.next()) {
       const protocol::Frame& frame = reader.frame();
       // bad_length comes from the prefix alone: there is no frame to hand over.
-      net::Outcome outcome = decoded->status == protocol::DecodeStatus::bad_length
-                                 ? conversation.on_broken_stream(*decoded)
-                                 : conversation.on_frame(frame.data(), frame.size());
-      for (const protocol::Frame& reply : outcome.replies)  // everything the server says must decode
-        check(protocol::decode_frame(reply.data(), reply.size(), protocol::Direction::to_client).ok());
-      if (outcome.command && std::holds_alternative<net::JoinCommand>(outcome.command->action)) {
-        net::Reply joined{1, net::JoinedReply{std::nullopt, "all player spheres are taken"}};
-        for (const protocol::Frame& reply : conversation.on_reply(joined).replies)
-          check(protocol::decode_frame(reply.data(), reply.size(), protocol::Direction::to_client).ok());
-        // Ticks 0 .. 39 sent, every fifth skipped: acks may be good, skipped, too old or in the future.
-        for (std::uint32_t tick = 0; tick < 40; ++tick)
-          if (tick % 5 != 4) conversation.on_snapshot_sent(tick);
-      }
-      if (outcome.disconnect || decoded->stream_broken()) return;
+      const net::Outcome outcome = decoded->status == protocol::DecodeStatus::bad_length
+                                       ? conversation.on_broken_stream(*decoded)
+                                       : conversation.on_frame(frame.data(), frame.size());
+      if (!carry_out(conversation, outcome) || decoded->stream_broken()) return;
     }
+  }
+}
+
+// The WebSocket path: each chunk is one message, a frame without its length prefix.
+void drive_server_websocket(const std::uint8_t* data, std::size_t size, std::size_t chunk) {
+  net::ClientProtocol conversation(1, kInfo);
+  for (std::size_t at = 0; at < size; at += chunk) {
+    // A buffer of its own, as Beast gives WebSession each message, so ASan sees the message's bounds.
+    const protocol::Frame message(data + at, data + std::min(size, at + chunk));
+    if (!carry_out(conversation, conversation.on_unprefixed_frame(message.data(), message.size()))) return;
   }
 }
 
@@ -104,6 +123,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   const std::size_t chunk = 1 + data[0] % 64 * 17;  // 1 .. 1072 bytes per read
   drive_server(data + 1, size - 1, chunk);
+  drive_server_websocket(data + 1, size - 1, chunk);
   drive_client(data + 1, size - 1, chunk);
   return 0;
 }

@@ -7,6 +7,7 @@ an over-size header gets 431. Frames are built and read with the Python client's
 import asyncio
 import http.client
 import os
+import subprocess
 
 import pytest
 import websockets
@@ -196,3 +197,12 @@ def test_without_a_built_page_the_server_says_how_to_build_it_and_ws_still_works
             return _message(await ws.recv()).PayloadType()
 
     assert _run(welcomed()) == Payload.Payload.Welcome
+
+
+def test_a_web_port_in_use_is_refused_with_a_message_naming_both_flags(start_server):
+    first = start_server("--balls", "0", "--web-port", "0")
+    second = subprocess.run([os.environ["FISHTANK_SERVER"], "--bind", "127.0.0.1", "--port", "0", "--balls", "0",
+                             "--web-port", str(first.web_port)], capture_output=True, text=True, timeout=30)
+    assert second.returncode == 1
+    assert f"127.0.0.1:{first.web_port}" in second.stderr
+    assert "--web-port" in second.stderr and "--no-web" in second.stderr

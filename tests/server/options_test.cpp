@@ -33,6 +33,10 @@ TEST_CASE("no flags: the paced server with 1000 balls on every core and the defa
   CHECK(r.options->threads == WorkerPool::hardware_threads());
   CHECK(r.options->port == 7878);
   CHECK(r.options->bind == "127.0.0.1");
+  CHECK(r.options->web);
+  CHECK(r.options->web_port == 8080);
+  CHECK(r.options->web_root == FISHTANK_DEFAULT_WEB_ROOT);
+  CHECK(r.options->limits.max_pending_per_address == 8);
   CHECK(r.options->physics.stiffness == PhysicsParams{}.stiffness);
 }
 
@@ -49,10 +53,14 @@ TEST_CASE("the help text (--help) lists every flag and exits 0 without starting 
                            "--status-interval",
                            "--bind",
                            "--port",
+                           "--web-port",
+                           "--no-web",
+                           "--web-root",
                            "--snapshot-rate",
                            "--max-players",
                            "--control",
                            "--max-connections",
+                           "--max-pending-per-address",
                            "--hello-timeout",
                            "--idle-timeout",
                            "--player-idle",
@@ -136,6 +144,10 @@ TEST_CASE("every bad value is refused with a message naming it and exit code 2",
       {{"--scene", "cube"}, "unknown scene 'cube'; the scenes are tank, wide, dam-break and drop"},
       {{"--control", "observers"}, "--control must be players, everyone or nobody"},
       {{"--port", "70000"}, "--port must be between"},
+      {{"--web-port", "-1"}, "--web-port must be between"},
+      {{"--port", "9000", "--web-port", "9000"}, "--port and --web-port are both 9000"},
+      {{"--no-web", "--web-port", "9000"}, "--no-web turns the web viewer off"},
+      {{"--max-pending-per-address", "0"}, "--max-pending-per-address must be between"},
       {{"--snapshot-rate", "0"}, "--snapshot-rate"},
       {{"--max-players", "-1"}, "--max-players"},
       {{"--max-balls", "-3"}, "--max-balls"},
@@ -177,13 +189,25 @@ TEST_CASE("the scalar build refuses more than one thread and says which build to
   CHECK(r.message.find("fishtank-server") != std::string::npos);
 }
 
+TEST_CASE("the web viewer's flags land where the network reads them", "[options]") {
+  const ParseResult r = parse({"--web-port", "0", "--web-root", "/srv/page"});
+  REQUIRE(r.options);
+  CHECK(r.options->web);
+  CHECK(r.options->web_port == 0);
+  CHECK(r.options->web_root == "/srv/page");
+  const ParseResult off = parse({"--no-web"});
+  REQUIRE(off.options);
+  CHECK_FALSE(off.options->web);
+}
+
 TEST_CASE("the limits on clients land where the network reads them", "[options]") {
   const ParseResult r =
-      parse({"--max-connections", "5", "--hello-timeout", "0.5", "--idle-timeout", "2", "--player-idle", "0",
-             "--max-commands", "50", "--add-rights", "everyone", "--add-rate", "100"});
+      parse({"--max-connections", "5", "--max-pending-per-address", "3", "--hello-timeout", "0.5", "--idle-timeout",
+             "2", "--player-idle", "0", "--max-commands", "50", "--add-rights", "everyone", "--add-rate", "100"});
   REQUIRE(r.options);
   const net::ClientLimits& l = r.options->limits;
   CHECK(l.max_connections == 5);
+  CHECK(l.max_pending_per_address == 3);
   CHECK(l.hello_timeout_s == 0.5);
   CHECK(l.idle_timeout_s == 2.0);
   CHECK(l.player_idle_s == 0.0);
