@@ -29,7 +29,7 @@ const camera = new OrbitCamera();
 const net = new Connection(wsUrl, !observerAsked, `web ${navigator.userAgent.split(' ').pop() ?? ''}`.slice(0, 64),
                            () => input.movement(camera).map((c) => c * PLAYER_SPEED));
 const hud = new Hud(document.getElementById('overlay')!);
-let framedClient = -1;  // the Welcome the camera was framed for
+let framed = '';  // the tank the camera was framed for: again only when a scene's tank differs
 let kindsOf: unknown = null;
 let showTank = true;
 let frames = 0;
@@ -53,10 +53,6 @@ function resize(): void {
 function frame(nowMs: number): void {
   const now = nowMs / 1000;
   const info = net.info;
-  if (info && info.clientId !== framedClient) {
-    camera.frame(info.tankMin, info.tankMax);
-    framedClient = info.clientId;
-  }
   if (info && kindsOf !== info) {
     renderer?.setKinds(info.kinds);
     kindsOf = info;
@@ -75,6 +71,11 @@ function frame(nowMs: number): void {
   let players: Player[] = [];
   let own = -1;
   if (pair) {
+    const tank = `${pair.to.tankMin} ${pair.to.tankMax}`;
+    if (tank !== framed) {
+      camera.frame(pair.to.tankMin, pair.to.tankMax);
+      framed = tank;
+    }
     // Players move a little between snapshots too; those new in `to` appear where they are.
     players = pair.to.players.map((pb) => {
       const pa = pair.from.players.find((p) => p.id === pb.id);
