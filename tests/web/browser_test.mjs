@@ -1,0 +1,139 @@
+// The browser viewer (web/) in a real, headless Chromium against a real
+// fishtank-server: what a student sees and does from a URL. One browser and
+// one server for all the checks, in order (each leaves the world as the next
+// expects); node --test reports each by name.
+
+import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import path from 'node:path';
+import { after, before, test } from 'node:test';
+import { countColours, launchBrowser, sleep, startServer, waitForState } from './harness.mjs';
+
+// Few balls: SwiftShader draws on the CPU, and two tabs share the test's cores.
+const SERVER_BALLS = 400;
+const SERVER_ARGS = ['--threads', '1', '--balls', String(SERVER_BALLS)];
+const outDir = process.env.FISHTANK_WEB_TEST_OUT || '.';
+let server;
+let browser;
+let page;
+const pageErrors = [];
+
+async function openPage() {
+  const p = await browser.newPage();
+  p.on('pageerror', (e) => pageErrors.push(String(e)));
+  p.on('console', (m) => m.type() === 'error' && !/WebSocket/.test(m.text()) && pageErrors.push(m.text()));
+  await p.goto(server.url);
+  return p;
+}
+
+const hudText = (p) => p.$eval('#stats', (e) => e.textContent);
+const own = (s) => s.players.find((p) => p.id === s.playerId);
+
+before(async () => {
+  server = await startServer(SERVER_ARGS);
+  browser = await launchBrowser();
+  page = await openPage();
+});
+
+after(async () => {
+  await browser?.close();
+  await server?.stop();
+});
+
+test('the page gets a WebGL2 context and a screenshot shows red, green and blue balls and the white player', async () => {
+  const s = await waitForState(page, (st) => st.drawnBalls > 0 && st.ownPlayerDrawn, 'balls and the player drawn');
+  assert.ok(s.webgl2, 'a WebGL2 context');
+  // The player starts amid the pouring balls; lifted above them (E), it is in plain view.
+  const y0 = own(s).pos[1];
+  await page.keyboard.down('KeyE');
+  await waitForState(page, (st) => own(st).pos[1] > y0 + 5, 'the player lifted 5 m');
+  await page.keyboard.up('KeyE');
+  await waitForState(page, (st) => st.ownPlayerDrawn[1] > y0 + 5, 'the lifted player drawn');
+  await page.keyboard.press('F1');  // the HUD off: its text is not the scene
+  await sleep(300);
+  const png = await page.screenshot({ type: 'png' });
+  fs.writeFileSync(path.join(outDir, 'web-page.png'), png);
+  await page.keyboard.press('F1');
+  const c = await countColours(page, png);
+  const summary = JSON.stringify(c);
+  assert.ok(c.background < 0.995 * c.total, `not blank: ${summary}`);
+  assert.ok(c.red >= 100 && c.green >= 100 && c.blue >= 100, `red, green and blue balls visible: ${summary}`);
+  assert.ok(c.blue > c.red && c.green > c.red, `the larger green and blue balls cover more than red: ${summary}`);
+  assert.ok(c.white >= 20 && c.white < 0.01 * c.total, `the small white player sphere: ${summary}`);
+});
+
+test('the page decodes delta snapshots against its Acks without asking for a keyframe', async () => {
+  const s = await waitForState(page, (st) => st.deltas >= 30, '30 delta snapshots');
+  assert.equal(s.keyframeRequests, 0);
+});
+
+test('B pours 1000 balls in: the server\'s count rises and the HUD shows it', async () => {
+  const before = (await waitForState(page, (st) => st.serverBalls > 0, 'a snapshot')).serverBalls;
+  await page.keyboard.press('KeyB');
+  await waitForState(page, (st) => st.serverBalls >= before + 1000, `${before + 1000} balls`);
+  await sleep(1000);  // the HUD is rewritten every frame, and a software-rendered frame is slow
+  const shown = Number((await hudText(page)).match(/Balls(\d+)/)?.[1]);
+  assert.ok(shown >= before + 1000, `the HUD shows ${shown} balls, ${before} + 1000 at least expected`);
+});
+
+test('holding D moves the player sphere to the camera\'s right (+x at the start)', async () => {
+  const start = own(await waitForState(page, (st) => own(st), 'the own player'));
+  await page.keyboard.down('KeyD');
+  await sleep(800);
+  await page.keyboard.up('KeyD');
+  const moved = own(await waitForState(page, (st) => own(st).pos[0] > start.pos[0] + 2, 'the player moved 2 m along +x'));
+  assert.ok(Math.abs(moved.pos[2] - start.pos[2]) < 0.5, `not along z: ${JSON.stringify([start, moved])}`);
+});
+
+test('two tabs see one world: each sees the other\'s player, and one tab\'s move in the other', async () => {
+  const second = await openPage();
+  const s2 = await waitForState(second, (st) => st.connection === 'connected' && own(st), 'the second tab\'s player');
+  const s1 = await waitForState(page, (st) => st.players.some((p) => p.id === s2.playerId), 'tab 1 sees tab 2\'s player');
+  assert.notEqual(s1.clientId, s2.clientId);
+  assert.ok(s2.players.some((p) => p.id === s1.playerId), 'tab 2 sees tab 1\'s player');
+  assert.equal(s2.serverBalls, s1.serverBalls, 'the same balls');
+  const x0 = s1.players.find((p) => p.id === s2.playerId).pos[0];
+  await second.keyboard.down('KeyA');
+  await sleep(800);
+  await second.keyboard.up('KeyA');
+  await waitForState(page, (st) => st.players.find((p) => p.id === s2.playerId).pos[0] < x0 - 2,
+                     'tab 1 sees tab 2\'s player move 2 m along -x');
+  await second.close();
+});
+
+test('the HUD says "disconnected" when the server stops, and the page reconnects when it returns', async () => {
+  const port = server.port;
+  await server.stop();
+  await waitForState(page, (st) => st.connection !== 'connected', 'the page to notice');
+  await sleep(1200);
+  assert.match(await hudText(page), /disconnected, last update \d+ s ago/);
+  server = await startServer(SERVER_ARGS, port);
+  const s = await waitForState(page, (st) => st.welcomes >= 2 && st.connection === 'connected' && st.serverBalls > 0,
+                               'a new Welcome and a snapshot');
+  assert.ok(s.serverBalls <= SERVER_BALLS, `the new server's world, not the old one's ${SERVER_BALLS + 1000} balls`);
+  await sleep(300);
+  assert.doesNotMatch(await hudText(page), /disconnected/);
+});
+
+test('where the server has no player sphere to give, the page observes, says why, and P is refused', async () => {
+  const full = await startServer(['--threads', '1', '--balls', '100', '--max-players', '0']);
+  try {
+    const p = await browser.newPage();
+    await p.goto(full.url);
+    const s = await waitForState(p, (st) => st.connection === 'connected' && st.serverBalls > 0, 'a snapshot');
+    assert.equal(s.hasPlayer, false);
+    await p.keyboard.press('KeyP');
+    await sleep(1000);
+    const hud = await hudText(p);
+    assert.match(hud, /Playerobserving: player_limit/);
+    assert.match(hud, /Controlnot yours/);
+    assert.match(hud, /not_permitted/);
+    await p.close();
+  } finally {
+    await full.stop();
+  }
+});
+
+test('the page threw no errors', () => {
+  assert.deepEqual(pageErrors, []);
+});

@@ -1,0 +1,105 @@
+// The statistics panel and the help overlay, as HTML over the canvas. Figures
+// that came from the server are greyed, with the reason, when the link is down.
+
+import { controlText, freshnessNote, threadsText, timeScaleText } from './hud_text';
+import type { Connection } from './net';
+
+const HELP: [string, string][] = [
+  ['W / S', 'move your sphere forward / back (away from / towards the camera)'],
+  ['A / D', 'move your sphere left / right'],
+  ['E or Space', 'move your sphere up'],
+  ['Q or Shift', 'move your sphere down'],
+  ['Left-drag', 'orbit the camera around the tank'],
+  ['Wheel', 'zoom in / out'],
+  ['B', 'pour 1000 more balls in from the top'],
+  ['P', 'pause / resume the simulation (for everyone)'],
+  ['O', 'one step (pauses first)'],
+  ['R', 'reset: the scene from its start'],
+  ['[ / ]', 'time scale slower / faster: 0.1, 0.25, 0.5, 1'],
+  ['1 2 3 4', 'scene: tank, wide, dam-break, drop'],
+  ['', '(P O R [ ] 1-4 as the server\'s --control allows: see Control)'],
+  ['T', 'show / hide the tank\'s edges'],
+  ['F1', 'show / hide the statistics'],
+  ['H', 'show / hide this help'],
+];
+
+export interface HudView {
+  fps: number;
+  frameMs: number;
+  now: number;  // seconds, the clock of Connection.lastUpdate
+  renderDelayMs: number;
+  observerAsked: boolean;
+  webgl: string;  // '' when WebGL2 works, else why not
+}
+
+export class Hud {
+  private readonly stats: HTMLElement;
+  private readonly help: HTMLElement;
+
+  constructor(root: HTMLElement) {
+    this.stats = document.createElement('div');
+    this.stats.id = 'stats';
+    this.help = document.createElement('div');
+    this.help.id = 'help';
+    this.help.hidden = true;
+    const table = document.createElement('table');
+    for (const [key, what] of HELP) {
+      const row = table.insertRow();
+      row.insertCell().textContent = key;
+      row.insertCell().textContent = what;
+    }
+    const title = document.createElement('h2');
+    title.textContent = 'Controls';
+    this.help.append(title, table);
+    root.append(this.stats, this.help);
+  }
+
+  toggleHelp(): void {
+    this.help.hidden = !this.help.hidden;
+  }
+
+  toggleStats(): void {
+    this.stats.hidden = !this.stats.hidden;
+  }
+
+  update(net: Connection, v: HudView): void {
+    if (this.stats.hidden) return;
+    const s = net.snapshots.newest();
+    const info = net.info;
+    const note = freshnessNote(net.state === 'connected', v.now, s ? net.lastUpdate : -1);
+    const live = note === '';
+    const rows: [string, string, boolean][] = [];  // label, value, live (the page's own figures always are)
+    const row = (label: string, value: string, fromServer = true): void => {
+      rows.push([label, value, !fromServer || live]);
+    };
+    row('Frames', `${v.fps.toFixed(1)} fps   ${v.frameMs.toFixed(2)} ms/frame`, false);
+    row('Physics', s ? `${s.stepsPerS.toFixed(0)} steps/s   load ${(100 * s.load).toFixed(0)} %` : '-');
+    row('Time', s ? timeScaleText(s.timeScale, s.timeScaleSet, s.paused) : '-');
+    row('Scene', s ? `${s.scene || '-'} (start ${s.sceneStart})` : '-');
+    row('Balls', s ? `${s.ballCount}` : '-');
+    row('Threads', info ? threadsText(s ? s.threadsStepping : 0, info.threads) : '-');
+    row('Server', info ? `${info.variant} (SIMD ${info.simd})` : location.host);
+    row('Snapshots', `${net.snapshotsPerS.toFixed(1)} /s   render delay ${v.renderDelayMs.toFixed(0)} ms`);
+    const perBall = s && s.ballCount > 0 && net.snapshotsPerS > 0 ? `, ${(net.bytesPerS / (net.snapshotsPerS * s.ballCount)).toFixed(2)} B per ball` : '';
+    row('Bandwidth', `${(net.bytesPerS / 1024).toFixed(1)} KiB/s in${perBall}`);
+    row('Round trip', net.rttMs >= 0 ? `${net.rttMs.toFixed(2)} ms` : '-');
+    if (info) {
+      row('Player', info.hasPlayer ? 'yours is the white sphere with the amber ring'
+        : v.observerAsked ? 'observing, as asked (?observer)' : `observing: ${net.observing || 'the server gave no player sphere'}`);
+      row('Control', controlText(info.mayControl, info.controlPolicy));
+    }
+
+    const lines = rows.map(([label, value, fresh]) =>
+      `<div class="row${fresh ? '' : ' stale'}"><span class="label">${label}</span><span>${escape(value)}</span></div>`);
+    if (v.webgl) lines.unshift(`<div class="warn">${escape(v.webgl)}</div>`);
+    if (!live) lines.push(`<div class="warn" id="freshness">${escape(note)}</div>`);
+    const notice = net.currentNotice();
+    if (notice) lines.push(`<div class="warn notice">${escape(notice)}</div>`);
+    lines.push('<div class="dim">H: help</div>');
+    this.stats.innerHTML = lines.join('');
+  }
+}
+
+function escape(text: string): string {
+  return text.replace(/[&<>"]/g, (c) => `&#${c.charCodeAt(0)};`);
+}

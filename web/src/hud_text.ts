@@ -1,0 +1,33 @@
+// What the HUD says, the same words as the GLFW viewer's (viewer/hud_text.h).
+
+// Below this the world runs in slow motion (kSlowMotionBelow, common/time_scale.h).
+const SLOW_MOTION_BELOW = 0.98;
+
+// Why the server's figures are not live, or '' when they are.
+export function freshnessNote(connected: boolean, now: number, lastUpdate: number): string {
+  if (connected) return '';
+  if (lastUpdate < 0) return 'not connected, no update yet';
+  // Whole seconds, so the count ticks up once a second like a clock.
+  return `disconnected, last update ${Math.floor(Math.max(0, now - lastUpdate))} s ago`;
+}
+
+export function threadsText(stepping: number, available: number): string {
+  const plural = available === 1 ? '' : 's';
+  return stepping === 0 ? `${available} thread${plural} at most` : `stepping on ${stepping} of ${available} thread${plural}`;
+}
+
+// "paused"; "real time"; "×0.50 as set"; "slow motion ×0.42" (with "(×0.50 set)"
+// when slowed too); "-" when the server did not say. A set scale of 0 counts as 1.
+export function timeScaleText(timeScale: number, timeScaleSet: number, paused: boolean): string {
+  if (paused) return 'paused';
+  if (!(timeScale > 0)) return '-';
+  const set = timeScaleSet > 0 ? timeScaleSet : 1;
+  const slowed = set < SLOW_MOTION_BELOW;
+  if (timeScale < SLOW_MOTION_BELOW * set)
+    return `slow motion \u00d7${timeScale.toFixed(2)}${slowed ? ` (\u00d7${set.toFixed(2)} set)` : ''}`;
+  return slowed ? `\u00d7${set.toFixed(2)} as set` : 'real time';
+}
+
+export function controlText(mayControl: boolean, policy: string): string {
+  return (mayControl ? 'yours (P O R [ ] 1-4): ' : 'not yours: ') + policy;
+}

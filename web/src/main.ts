@@ -1,0 +1,127 @@
+// The browser viewer: connects to the server that served the page (its /ws),
+// draws what it sends, and sends back the keys. The loop, once per display frame:
+//   input ─► velocity, commands ─► Connection      Connection ─► SnapshotBuffer
+//   SnapshotBuffer.frameAt(now) ─► Renderer.draw ─► HUD
+//
+// URL options: ?observer (ask for no player sphere), ?ws=URL (another server).
+
+import { OrbitCamera } from './camera';
+import { Input, sandboxFrames } from './controls';
+import { Hud } from './hud';
+import { Connection } from './net';
+import { Renderer } from './render';
+import type { Player } from './snapshots';
+import * as wire from './wire';
+
+const PLAYER_SPEED = 8;  // m/s; the server clamps at its own maximum
+const BALLS_PER_PRESS = 1000;
+
+const params = new URLSearchParams(location.search);
+const observerAsked = params.has('observer');
+const wsUrl = params.get('ws') ?? `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/ws`;
+
+const canvas = document.getElementById('view') as HTMLCanvasElement;
+const gl = canvas.getContext('webgl2', { antialias: true });
+const renderer = gl ? new Renderer(gl) : null;
+const webglProblem = gl ? '' : 'This browser gives the page no WebGL2 context: nothing can be drawn (the HUD still works).';
+const input = new Input(canvas);
+const camera = new OrbitCamera();
+const net = new Connection(wsUrl, !observerAsked, `web ${navigator.userAgent.split(' ').pop() ?? ''}`.slice(0, 64),
+                           () => input.movement(camera).map((c) => c * PLAYER_SPEED));
+const hud = new Hud(document.getElementById('overlay')!);
+let framed = '';  // the tank the camera was framed for: again only when a scene's tank differs
+let kindsOf: unknown = null;
+let showTank = true;
+let frames = 0;
+let fps = 0;
+let frameMs = 0;
+let fpsStarted = performance.now();
+let ownPlayer: Player | null = null;
+let drawnBalls = 0;
+let framesDrawn = 0;
+
+function resize(): void {
+  const dpr = window.devicePixelRatio || 1;
+  const w = Math.round(canvas.clientWidth * dpr);
+  const h = Math.round(canvas.clientHeight * dpr);
+  if (canvas.width !== w || canvas.height !== h) {
+    canvas.width = w;
+    canvas.height = h;
+  }
+}
+
+function frame(nowMs: number): void {
+  const now = nowMs / 1000;
+  const info = net.info;
+  if (info && kindsOf !== info) {
+    renderer?.setKinds(info.kinds);
+    kindsOf = info;
+  }
+
+  const a = input.takeActions();
+  if (a.toggleHelp) hud.toggleHelp();
+  if (a.toggleHud) hud.toggleStats();
+  if (a.toggleTank) showTank = !showTank;
+  if (a.addBalls) net.send(wire.addBalls(BALLS_PER_PRESS));
+  for (const f of sandboxFrames(a, net.snapshots.newest())) net.send(f);
+  input.driveCamera(camera);
+
+  resize();
+  const pair = net.snapshots.frameAt(now);
+  let players: Player[] = [];
+  let own = -1;
+  if (pair) {
+    const tank = `${pair.to.tankMin} ${pair.to.tankMax}`;
+    if (tank !== framed) {
+      camera.frame(pair.to.tankMin, pair.to.tankMax);
+      framed = tank;
+    }
+    // Players move a little between snapshots too; those new in `to` appear where they are.
+    players = pair.to.players.map((pb) => {
+      const pa = pair.from.players.find((p) => p.id === pb.id);
+      const pos = pa ? pb.pos.map((c, i) => pa.pos[i] + (c - pa.pos[i]) * pair.alpha) as Player['pos'] : pb.pos;
+      return { id: pb.id, pos };
+    });
+    if (info?.hasPlayer) own = players.findIndex((p) => p.id === info.playerId);
+  }
+  ownPlayer = own >= 0 ? players[own] : null;
+  drawnBalls = pair ? pair.to.ballCount : 0;
+  renderer?.draw(camera.viewProjection(canvas.width / Math.max(1, canvas.height)), pair, players, own, showTank);
+
+  ++frames;
+  ++framesDrawn;
+  const elapsed = nowMs - fpsStarted;
+  if (elapsed >= 500) {
+    fps = (1000 * frames) / elapsed;
+    frameMs = elapsed / frames;
+    frames = 0;
+    fpsStarted = nowMs;
+  }
+  hud.update(net, { fps, frameMs, now, renderDelayMs: 1000 * net.snapshots.renderDelay(), observerAsked, webgl: webglProblem });
+  requestAnimationFrame(frame);
+}
+requestAnimationFrame(frame);
+
+// What the browser tests (tests/web) read; plain values, so page.evaluate can return them.
+(window as unknown as { fishtank: unknown }).fishtank = {
+  state: () => ({
+    webgl2: gl !== null,
+    connection: net.state,
+    welcomes: net.welcomes,
+    hasPlayer: net.info?.hasPlayer ?? false,
+    playerId: net.info?.playerId ?? -1,
+    clientId: net.info?.clientId ?? -1,
+    ownPlayerDrawn: ownPlayer ? [...ownPlayer.pos] : null,
+    drawnBalls,
+    // From the newest snapshot, whether or not the tab is drawing (a hidden tab is not).
+    serverBalls: net.snapshots.newest()?.ballCount ?? 0,
+    players: net.snapshots.newest()?.players ?? [],
+    deltas: net.deltas,
+    keyframeRequests: net.keyframeRequests,
+    decoded: net.decoded,
+    decodeMs: net.decodeMs,
+    framesDrawn,
+    bytes: net.bytes,
+    fps,
+  }),
+};
