@@ -76,7 +76,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "web-port", po::value(&web_port)->default_value(web_port),
       "port of the browser viewer: the page over HTTP and WebSocket at /ws, on the --bind address (0: pick a free "
       "one and print it)")("no-web", po::bool_switch(&no_web), "serve no browser viewer (no HTTP/WebSocket port)")(
-      "web-root", po::value(&o.web_root)->default_value(o.web_root),
+      "web-root", po::value(&o.web_root)->default_value(o.web_root, "the build's web/dist"),
       "folder of the browser viewer's page, served read-only")(
       "snapshot-rate", po::value(&o.snapshot_rate)->default_value(o.snapshot_rate),
       "snapshots per second sent to clients")("max-players", po::value(&max_players)->default_value(max_players),

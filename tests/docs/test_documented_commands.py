@@ -35,6 +35,7 @@ EXCLUDED = {
     "scripts/test-tsan": "a ThreadSanitizer build and its tests, minutes; CI runs it after scripts/test",
     "scripts/test-asan": "an AddressSanitizer build and its tests, minutes; CI runs it after scripts/test",
     "cmake --preset release && cmake --build build": "configures and builds build/ while this suite runs from it",
+    "cmake --build build": "builds build/ while this suite runs from it",
     "scripts/bench-loaded": "minutes by design (busy processes beside timed runs); its --self-test is a ctest test",
     "build/server/fishtank-bench-variants": "settles a 6000-ball tank and times every kernel set, minutes",
     "build/server/fishtank-bench-variants --benchmark_filter=step_tank --benchmark_repetitions=8 "
@@ -46,6 +47,8 @@ EXCLUDED = {
     "scripts/figures": "installs gnuplot, sweeps for minutes and rewrites docs/figures/",
     "scripts/figures-load": "the loaded benchmark for minutes; rewrites docs/figures/",
     "scripts/figures-perf": "about 12 minutes; rewrites docs/figures/",
+    "scripts/figures-web": "a minute of headless Chromium; rewrites docs/figures/",
+    "scripts/figures-web-observers": "a minute and a half of WebSocket observers; rewrites docs/figures/",
     "scripts/abuse-table": "rebuilds the network tests and rewrites docs/figures/abuse.csv",
     "scripts/lammps-crosscheck": "times full scenes in fishtank-server and LAMMPS, minutes",
     "scripts/fuzz 60": "installs clang, builds a fuzzer and fuzzes for 60 s",

@@ -45,7 +45,7 @@ def help_flags(name):
         else:
             current = None
     for flag, description in text.items():
-        found = TEXT_DEFAULT.search(description)
+        found = TEXT_DEFAULT.search(" ".join(description.split()))  # a wrap can leave two spaces
         if flags[flag] is None and found:
             flags[flag] = found.group(1).strip()
     assert flags, f"no flags found in {name} --help:\n{out.stdout}"
