@@ -207,11 +207,13 @@ template <class V>
 [[gnu::always_inline]] inline void neighbour_forces(const StepArrays& s, const ContactModel& m,
                                                     const std::uint32_t* block, std::uint32_t blocks,
                                                     const GroupBalls<V>& i, V& fx, V& fy, V& fz) {
-  V kind_inv_m[kKindCount], kind_damping[kKindCount];  // a neighbour's kind is known by its 1 / mass
+  // A neighbour's kind is known by its 1 / mass: c and c / (1 + beta) of each pair, once per group.
+  V kind_inv_m[kKindCount], kind_c[kKindCount], kind_damping[kKindCount];
   for (int k = 0; k < kKindCount; ++k) {
     kind_inv_m[k] = V::splat(1.0f / kBallKinds[k].mass);
     const V inv_m_sum = i.inv_m + kind_inv_m[k];
-    kind_damping[k] = whole_step_damping(m, contact_damping(m, inv_m_sum), inv_m_sum);
+    kind_c[k] = contact_damping(m, inv_m_sum);
+    kind_damping[k] = whole_step_damping(m, kind_c[k], inv_m_sum);
   }
   const V lead_bound = V::splat(m.lead_bound);
   const V tiny = V::splat(1e-12f);  // squared distance floor: coincident centres stay finite
@@ -234,8 +236,9 @@ template <class V>
     const V v_n = mul_add(dvz, dz, mul_add(dvy, dy, dvx * dx)) * inv_dist;
     V f;
     if (simd::any(near & starting_or_ending(m, overlap, v_n))) [[unlikely]] {
-      const V inv_m_sum = i.inv_m + inv_mj;
-      f = keep(near, normal_force(m, overlap, v_n, contact_damping(m, inv_m_sum), inv_m_sum));
+      V c = kind_c[0];
+      for (int k = 1; k < kKindCount; ++k) c = select(inv_mj == kind_inv_m[k], kind_c[k], c);
+      f = keep(near, normal_force(m, overlap, v_n, c, i.inv_m + inv_mj));
     } else {
       V damping = kind_damping[0];
       for (int k = 1; k < kKindCount; ++k) damping = select(inv_mj == kind_inv_m[k], kind_damping[k], damping);
