@@ -3,14 +3,13 @@
 manual, and a real fishtank-server on an ephemeral 127.0.0.1 port."""
 
 import os
-import re
-import signal
-import subprocess
-import tempfile
-import time
+import sys
 from pathlib import Path
 
 import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "python"))
+import server_process  # noqa: E402  (tests/python, shared with the Python client's suite)
 
 SOURCE = Path(os.environ.get("FISHTANK_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 BUILD = Path(os.environ.get("FISHTANK_BUILD_DIR", SOURCE / "build"))
@@ -27,37 +26,9 @@ def markdown(doc):
     return (SOURCE / doc).read_text(encoding="utf-8")
 
 
-class Server:
-    """fishtank-server --port 0 plus args; its port is read from its "listening on" line."""
-
-    def __init__(self, *args):
-        self.log = tempfile.NamedTemporaryFile(prefix="fishtank-server-", suffix=".log", delete=False)
-        self.process = subprocess.Popen([str(program("fishtank-server")), "--bind", "127.0.0.1", "--port", "0", *args],
-                                        stderr=self.log, stdout=subprocess.DEVNULL)
-        deadline = time.monotonic() + 15
-        while time.monotonic() < deadline:
-            found = re.search(r"listening on 127\.0\.0\.1:(\d+)", self.text())
-            if found:
-                self.port = int(found.group(1))
-                return
-            if self.process.poll() is not None:
-                break
-            time.sleep(0.05)
-        self.stop()
-        raise RuntimeError("fishtank-server did not start listening:\n" + self.text())
-
-    def text(self):
-        return Path(self.log.name).read_text(encoding="utf-8", errors="replace")
-
-    def stop(self):
-        if self.process.poll() is None:
-            self.process.send_signal(signal.SIGTERM)
-            try:
-                self.process.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-                self.process.wait()
-        os.unlink(self.log.name)
+def Server(*args):
+    """fishtank-server of this build (tests/python/server_process.py)."""
+    return server_process.Server(program("fishtank-server"), *args)
 
 
 @pytest.fixture
