@@ -1,11 +1,9 @@
 #pragma once
 // Where the host placed this machine's cores, as a time: a cache line's trip
 // from one core to another. On a shared virtual machine two virtual cores may
-// sit close (~40-90 ns here) or apart (~220-350 ns, at times ~1 us), and the
-// placement changes from hour to hour; a scene whose threads share lines, as
-// a small one does along its chunks' edges, runs a third faster in the first
-// case (technical report, 6.2). The benchmarks print it so that a run says
-// which case it measured.
+// sit close or apart, and the placement changes from hour to hour; a scene whose threads share lines, as
+// a small one does along its chunks' edges, runs faster in the first case.
+// The benchmarks print it so that a run says which case it measured.
 
 #include <optional>
 #include <vector>

@@ -1,6 +1,6 @@
 #pragma once
 // Contact-model and time-step parameters, and the rules that derive one from
-// another (documented in docs/technical-report.md, "Time step from stiffness").
+// another (documented in docs/technical-report.md, section 2.4).
 //
 //   damping ratio    zeta = -ln e / sqrt(pi^2 + ln^2 e)
 //   pair damping     c    = 2 zeta sqrt(k m_eff),   m_eff = m1 m2 / (m1 + m2)

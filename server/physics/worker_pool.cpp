@@ -21,7 +21,7 @@ constexpr auto kWorkerSpin = std::chrono::microseconds(1000);
 // How long the caller polls for the last chunks before it yields between
 // polls, so that a thread descheduled inside a chunk can get the core back.
 // Yielding kept more of the caller's share of a busy machine than sleeping on
-// a condition variable (technical report 6.3).
+// a condition variable (technical report 5.1).
 constexpr auto kCallerSpin = std::chrono::microseconds(50);
 // Fewer items than this per thread cost more to hand out than to compute.
 constexpr std::uint32_t kMinItemsPerThread = 1024;

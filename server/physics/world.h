@@ -224,7 +224,7 @@ class World {
 
   std::uint32_t capacity_;
   std::uint32_t max_balls_;
-  // Tunable: a strayed ball's check costs about what a rebuild costs per two balls (measured, report).
+  // Tunable: a strayed ball's check is taken to cost what a rebuild costs per two balls.
   static constexpr double kRebuildCostInChecksPerBall = 0.5;
   // Past n / kStrayedBallsPerCheck (+ 16) strayed balls the lists are rebuilt: by then checks go on
   // finding nothing only to end in a missed contact a few steps later.
