@@ -20,8 +20,9 @@
 // the window in contact (a triangle where it starts or ends, x itself where it
 // lasts). Where it starts or ends, the lead is taken once more from the rate at
 // mid-window, after the spring's half kick: start and end then mirror each
-// other, and an elastic contact neither gains nor loses energy on average. The dashpot acts over that part, f dt, on
-// the relative speed solved implicitly for this contact alone: beta = c f dt / (2 m_eff) and
+// other, and an elastic contact neither gains nor loses energy on average.
+// The dashpot acts over that part, f dt, on the relative speed solved
+// implicitly for this contact alone: beta = c f dt / (2 m_eff) and
 //   F = k mean_overlap - c f / (1 + beta) v_n.
 // The implicit factor touches the dashpot only, so a resting contact (v_n = 0)
 // rests on k x. That is the pair's trapezoid rule on a spring k (1 + beta),

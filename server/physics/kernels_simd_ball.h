@@ -202,7 +202,7 @@ struct GroupBalls {
 // Most blocks hold contacts that last the whole step (or none): their law is
 // k x - damping v_n, with damping taken by the neighbour's kind from a table
 // made once per group; a block with a contact starting or ending takes the
-// whole law (contact_law.h). Both give the scalar twin's value.
+// whole law (contact_law.h). Both give the scalar twin's value to float rounding.
 template <class V>
 [[gnu::always_inline]] inline void neighbour_forces(const StepArrays& s, const ContactModel& m,
                                                     const std::uint32_t* block, std::uint32_t blocks,

@@ -45,6 +45,7 @@ EXCLUDED = {
     "build/server/fishtank-accuracy": "the accuracy sweeps, minutes (scripts/figures runs them)",
     "scripts/callgrind-step": "valgrind over every variant, minutes",
     "scripts/figures": "installs gnuplot, sweeps for minutes and rewrites docs/figures/",
+    "scripts/figures-capacity": "six benchmarks of the settled tank, a minute; rewrites docs/figures/",
     "scripts/figures-load": "the loaded benchmark for minutes; rewrites docs/figures/",
     "scripts/figures-perf": "about 12 minutes; rewrites docs/figures/",
     "scripts/figures-web": "a minute of headless Chromium; rewrites docs/figures/",
