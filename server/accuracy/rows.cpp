@@ -1,7 +1,6 @@
 #include "server/accuracy/rows.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 
 #include "server/accuracy/reference.h"

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
-#include <vector>
 
 #include "tests/physics/scenarios.h"
 
