@@ -112,9 +112,11 @@ void Hud::stats(const HudView& v) {
   if (const ServerInfo* info = net.info.get()) {
     row(live, "Threads", "%s", threads_text(s ? s->threads_stepping : 0, info->threads).c_str());
     row(live, "Server", "%s (SIMD %s)", info->variant.c_str(), info->simd.c_str());
+    row(live, "Step", "%s", step_text(info->dt, info->steps_per_contact, info->tolerance).c_str());
   } else {
     row(live, "Threads", "-");
     row(live, "Server", "%s", net.endpoint.c_str());
+    row(live, "Step", "-");
   }
   row(live, "Snapshots", "%.1f /s   render delay %.0f ms", net.snapshots_per_s, v.render_delay_ms);
   // Bytes received, frames whole: with deltas a still pile costs a fraction of a byte per ball.

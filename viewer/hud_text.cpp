@@ -51,6 +51,21 @@ std::string time_scale_text(float time_scale, float time_scale_set, bool paused)
   return text;
 }
 
+std::string step_text(float dt, float steps_per_contact, float tolerance) {
+  if (dt <= 0.0f) return "-";
+  char text[128];
+  const double ms = 1e3 * dt;
+  if (steps_per_contact <= 0.0f)
+    std::snprintf(text, sizeof text, "%.3g ms", ms);
+  else if (tolerance > 0.0f)
+    std::snprintf(text, sizeof text, "%.3g ms, %.0f steps per contact: each collision's e within %g", ms,
+                  double(steps_per_contact), double(tolerance));
+  else
+    std::snprintf(text, sizeof text, "%.3g ms (given), %.1f steps per contact", ms,
+                  double(steps_per_contact));
+  return text;
+}
+
 std::string control_text(bool may_control, const std::string& policy) {
   return (may_control ? "yours (P O R [ ] 1-4): " : "not yours: ") + policy;
 }

@@ -34,6 +34,12 @@ struct OverlapText {
 };
 OverlapText overlap_text(float fraction);
 
+// How the server chose its time step: "1.08 ms, 13 steps per contact: each
+// collision's e within 0.005"; "0.70 ms (given), 20.0 steps per contact" when
+// dt or the steps per contact were given; "1.08 ms" from a server that does
+// not say; "-" without a dt.
+std::string step_text(float dt, float steps_per_contact, float tolerance);
+
 // Who may use the sandbox's controls, for the HUD: this viewer's part first.
 std::string control_text(bool may_control, const std::string& policy);
 

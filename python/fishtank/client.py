@@ -112,6 +112,8 @@ class Client:
         w = self.welcome
         self.player_id = w.PlayerId() if w.HasPlayer() else None
         self.dt = w.Dt()
+        self.steps_per_contact = w.StepsPerContact()  # contact duration of the lightest pair / dt
+        self.tolerance = w.Tolerance()  # the per-collision error dt was chosen for; 0: dt given
         self.may_control = w.MayControl()
         self.control_policy = (w.ControlPolicy() or b"").decode()
         self.kinds = [(w.BallKinds(k).Diameter(), w.BallKinds(k).Mass()) for k in range(w.BallKindsLength())]

@@ -263,6 +263,8 @@ Outcome ClientProtocol::on_reply(const Reply& reply) {
     w.worker_threads = info_.worker_threads;
     w.tank = info_.tank;
     w.dt = info_.dt;
+    w.steps_per_contact = info_.steps_per_contact;
+    w.tolerance = info_.tolerance;
     w.player_id = joined->player_id;
     w.snapshot_rate_hz = info_.snapshot_rate_hz;
     has_player_ = joined->player_id.has_value();

@@ -32,6 +32,8 @@ struct ServerInfo {
   std::uint32_t worker_threads = 1;
   TankBounds tank;
   float dt = 0.0f;
+  float steps_per_contact = 0.0f;  // contact duration of the lightest pair / dt
+  float tolerance = 0.0f;          // the per-collision error dt was chosen for; 0: dt given
   float snapshot_rate_hz = 60.0f;
   ControlPolicy control = ControlPolicy::players;
   ClientLimits limits;

@@ -42,6 +42,8 @@ TEST_CASE("every message survives encode then decode with its values intact", "[
     w.snapshot_rate_hz = 60.0f;
     w.control_policy = "players may";
     w.may_control = true;
+    w.steps_per_contact = 13.0f;
+    w.tolerance = 0.005f;
     const protocol::Frame f = protocol::encode_welcome(w);
     const auto r = decode(f, Direction::to_client);
     REQUIRE(r.ok());
@@ -55,6 +57,8 @@ TEST_CASE("every message survives encode then decode with its values intact", "[
     CHECK(m.tank_max()->y() == 40.0f);
     CHECK(m.control_policy()->str() == "players may");
     CHECK(m.may_control());
+    CHECK(m.steps_per_contact() == 13.0f);
+    CHECK(m.tolerance() == 0.005f);
   }
   SECTION("Snapshot") {
     const std::vector<std::uint16_t> q{1, 2, 3, 65535, 0, 7};

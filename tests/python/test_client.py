@@ -46,6 +46,19 @@ def test_positions_agree_with_the_servers_own_state_within_half_a_quantisation_s
     assert np.all(error <= half_step * 1.01 + 1e-5), error.max(axis=0)
 
 
+def test_the_welcome_says_how_dt_was_chosen_from_the_tolerance_or_given(start_server):
+    with Client("127.0.0.1", start_server("--balls", "10").port) as tank:
+        assert tank.tolerance == pytest.approx(0.005)
+        assert tank.steps_per_contact == pytest.approx(13, rel=1e-4)  # ceil(sqrt(0.8 / 0.005))
+        contact_duration = tank.steps_per_contact * tank.dt
+    with Client("127.0.0.1", start_server("--balls", "10", "--tolerance", "0.002").port) as tank:
+        assert tank.tolerance == pytest.approx(0.002)
+        assert tank.steps_per_contact == pytest.approx(20, rel=1e-4)
+    with Client("127.0.0.1", start_server("--balls", "10", "--dt", "0.0005").port) as tank:
+        assert tank.tolerance == 0.0
+        assert tank.steps_per_contact * tank.dt == pytest.approx(contact_duration, rel=1e-5)  # fixed by k
+
+
 def test_pause_holds_still_and_step_runs_exactly_the_steps_asked_for(start_server):
     server = start_server("--balls", "200")
     with Client("127.0.0.1", server.port) as tank:

@@ -17,6 +17,14 @@ TEST_CASE("an overlap beyond a tenth of the smaller radius is a warning, a light
   CHECK(deep.text == "52.0 % of the smaller radius: stiffness too soft for the load");
 }
 
+TEST_CASE("the step row says how dt was chosen: from the tolerance, given, or not said") {
+  CHECK(step_text(1.08e-3f, 13.0f, 0.005f) ==
+        "1.08 ms, 13 steps per contact: each collision's e within 0.005");
+  CHECK(step_text(0.7e-3f, 20.04f, 0.0f) == "0.7 ms (given), 20.0 steps per contact");
+  CHECK(step_text(1.08e-3f, 0.0f, 0.0f) == "1.08 ms");  // a server from before the fields
+  CHECK(step_text(0.0f, 13.0f, 0.005f) == "-");
+}
+
 TEST_CASE("while connected the server's figures are live") {
   const Freshness f = figures_freshness(true, 100.0, 99.98);
   CHECK(f.live);

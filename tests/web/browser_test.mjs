@@ -66,6 +66,10 @@ test('the page gets a WebGL2 context and a screenshot shows red, green and blue 
   assert.ok(c.white >= 20 && c.white < 0.01 * c.total, `the small white player sphere: ${summary}`);
 });
 
+test('the HUD says how the server chose dt: 13 steps per contact from the default tolerance', async () => {
+  assert.match(await hudText(page), /Step[\d.]+ ms, 13 steps per contact: each collision's e within 0\.005/);
+});
+
 test('the page decodes delta snapshots against its Acks without asking for a keyframe', async () => {
   const s = await waitForState(page, (st) => st.deltas >= 30, '30 delta snapshots');
   assert.equal(s.keyframeRequests, 0);

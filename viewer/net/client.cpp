@@ -200,6 +200,8 @@ void NetClient::on_welcome(const wire::Welcome& w) {
   info->threads = static_cast<int>(w.worker_threads());
   info->tank = {to_vec3(*w.tank_min()), to_vec3(*w.tank_max())};  // present: decode_frame checks
   info->dt = w.dt();
+  info->steps_per_contact = w.steps_per_contact();
+  info->tolerance = w.tolerance();
   for (const wire::BallKindInfo* k : *w.ball_kinds())
     info->kinds.push_back({k->diameter(), k->mass(), {k->r(), k->g(), k->b()}});
   info->client_id = w.client_id();

@@ -20,7 +20,9 @@ struct ServerInfo {
   int threads = 0;      // worker threads at most; Snapshot::threads_stepping says how many step now
   TankBounds tank;
   float dt = 0.0f;
-  std::vector<BallKind> kinds;  // indexed by a ball's kind number
+  float steps_per_contact = 0.0f;  // contact duration of the lightest pair / dt; 0: not reported
+  float tolerance = 0.0f;          // the per-collision error dt was chosen for; 0: dt given
+  std::vector<BallKind> kinds;     // indexed by a ball's kind number
   std::uint32_t client_id = 0;
   std::string control_policy;  // who may pause, step, reset, switch scene, set the time scale
   bool may_control = false;    // whether this viewer may

@@ -1,7 +1,7 @@
 // The statistics panel and the help overlay, as HTML over the canvas. Figures
 // that came from the server are greyed, with the reason, when the link is down.
 
-import { controlText, freshnessNote, threadsText, timeScaleText } from './hud_text';
+import { controlText, freshnessNote, stepText, threadsText, timeScaleText } from './hud_text';
 import type { Connection } from './net';
 
 const HELP: [string, string][] = [
@@ -79,6 +79,7 @@ export class Hud {
     row('Balls', s ? `${s.ballCount}` : '-');
     row('Threads', info ? threadsText(s ? s.threadsStepping : 0, info.threads) : '-');
     row('Server', info ? `${info.variant} (SIMD ${info.simd})` : location.host);
+    row('Step', info ? stepText(info.dt, info.stepsPerContact, info.tolerance) : '-');
     row('Snapshots', `${net.snapshotsPerS.toFixed(1)} /s   render delay ${v.renderDelayMs.toFixed(0)} ms`);
     const perBall = s && s.ballCount > 0 && net.snapshotsPerS > 0 ? `, ${(net.bytesPerS / (net.snapshotsPerS * s.ballCount)).toFixed(2)} B per ball` : '';
     row('Bandwidth', `${(net.bytesPerS / 1024).toFixed(1)} KiB/s in${perBall}`);

@@ -28,6 +28,18 @@ export function timeScaleText(timeScale: number, timeScaleSet: number, paused: b
   return slowed ? `\u00d7${set.toFixed(2)} as set` : 'real time';
 }
 
+// How the server chose its time step: "1.08 ms, 13 steps per contact: each
+// collision's e within 0.005"; "0.7 ms (given), 20.0 steps per contact"; "1.08 ms"
+// from a server that does not say; "-" without a dt.
+export function stepText(dt: number, stepsPerContact: number, tolerance: number): string {
+  if (!(dt > 0)) return '-';
+  const ms = Number((1e3 * dt).toPrecision(3));
+  if (!(stepsPerContact > 0)) return `${ms} ms`;
+  if (tolerance > 0)
+    return `${ms} ms, ${stepsPerContact.toFixed(0)} steps per contact: each collision's e within ${Number(tolerance.toPrecision(6))}`;
+  return `${ms} ms (given), ${stepsPerContact.toFixed(1)} steps per contact`;
+}
+
 export function controlText(mayControl: boolean, policy: string): string {
   return (mayControl ? 'yours (P O R [ ] 1-4): ' : 'not yours: ') + policy;
 }

@@ -21,6 +21,9 @@ export interface ServerInfo {
   threads: number;
   tankMin: [number, number, number];
   tankMax: [number, number, number];
+  dt: number;
+  stepsPerContact: number;  // contact duration of the lightest pair / dt; 0: not reported
+  tolerance: number;  // the per-collision error dt was chosen for; 0: dt given
   kinds: BallKind[];
   hasPlayer: boolean;
   playerId: number;
@@ -164,6 +167,9 @@ export class Connection {
       threads: w.workerThreads(),
       tankMin: vec(w.tankMin()),
       tankMax: vec(w.tankMax()),
+      dt: w.dt(),
+      stepsPerContact: w.stepsPerContact(),
+      tolerance: w.tolerance(),
       kinds,
       hasPlayer: w.hasPlayer(),
       playerId: w.playerId(),
