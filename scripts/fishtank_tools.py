@@ -235,6 +235,9 @@ def variants(avx2_one_thread=False):
 
 def build_targets(build, *extra):
     """Brings the server variants (and `extra` targets) up to date in build."""
+    if not os.path.exists(os.path.join(build, "CMakeCache.txt")):
+        sys.exit(f"{os.path.basename(sys.argv[0])}: {build} is not a configured build; make one with "
+                 "cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release")
     targets = ["fishtank-server", "fishtank-server-scalar"] + (["fishtank-server-avx2"] if has_avx2() else [])
     subprocess.run(["cmake", "--build", build, "--target", *targets, *extra], check=True, stdout=subprocess.DEVNULL)
 
