@@ -1,6 +1,6 @@
 // fishtank-accuracy: the measurements of SPEC 7.1 and 7.2 (docs/accuracy.md).
 //
-//   fishtank-accuracy [--out DIR] [--quick] [--scalar] [--collisions-only]
+//   fishtank-accuracy [--out DIR] [--quick] [--scalar | --avx2] [--collisions-only]
 //
 // Writes to DIR (default .):
 //   rows.csv              a ball hitting a row of 1, 2 or 4 (chain, cradle): error per steps per contact
@@ -9,8 +9,8 @@
 //   accuracy-orders.csv   observed order of each scene and method, vs dt and vs CPU time
 //   stability.csv         the (k, dt) map with its measurements and class
 //   stability-product.csv the server's automatic dt at the default k, classified
-// and prints a summary. --quick runs a coarse sweep (seconds); --scalar uses
-// the scalar kernels instead of the SSE ones the server ships.
+// and prints a summary. --quick runs a coarse sweep (seconds); --scalar and
+// --avx2 use those kernels instead of the SSE ones fishtank-server ships.
 
 #include <cmath>
 #include <cstdio>
@@ -25,6 +25,7 @@
 #include "server/accuracy/rows.h"
 #include "server/accuracy/stability.h"
 #include "server/accuracy/sweep.h"
+#include "server/physics/kernels.h"
 #include "server/physics/params.h"
 
 using namespace fishtank;
@@ -51,6 +52,8 @@ bool parse(int argc, char** argv, Options& o) {
       o.collisions_only = true;
     else if (!std::strcmp(argv[i], "--scalar"))
       o.kernels = &kScalarKernels;
+    else if (!std::strcmp(argv[i], "--avx2"))
+      o.kernels = &kAvx2Kernels;
     else
       return false;
   }
@@ -184,7 +187,11 @@ void run_stability(const Options& o) {
 int main(int argc, char** argv) {
   Options o;
   if (!parse(argc, argv, o)) {
-    std::fprintf(stderr, "usage: fishtank-accuracy [--out DIR] [--quick] [--scalar] [--collisions-only]\n");
+    std::fprintf(stderr, "usage: fishtank-accuracy [--out DIR] [--quick] [--scalar | --avx2] [--collisions-only]\n");
+    return 2;
+  }
+  if (o.kernels == &kAvx2Kernels && !cpu_has_avx2()) {
+    std::fprintf(stderr, "fishtank-accuracy: this processor has no AVX2; leave out --avx2\n");
     return 2;
   }
   try {

@@ -136,8 +136,9 @@ def prepare(command, port, lammps_dir):
     text = command.removesuffix("&").strip().replace("...", "")
     text = text.replace("otherhost", "127.0.0.1").replace("7878", str(port))
     text = re.sub(r"\bDIR\b", shlex.quote(str(lammps_dir)), text)
-    text = re.sub(r"(?<![\w/.$])build/", str(BUILD) + "/", text)
-    text = re.sub(r"(?<![\w/.$])(scripts|docs)/", lambda m: str(SOURCE / m.group(1)) + "/", text)
+    # one pass, so that a checkout path put in (which may hold "scripts/") is not rewritten again
+    text = re.sub(r"(?<![\w/.$])(build|scripts|docs)/",
+                  lambda m: str(BUILD if m.group(1) == "build" else SOURCE / m.group(1)) + "/", text)
     parts = []
     for part in re.split(r"\s*&&\s*", text):
         words = shlex.split(part)
