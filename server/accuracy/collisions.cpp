@@ -58,12 +58,18 @@ float measured_restitution(const Kernels& kernels, const PhysicsParams& params, 
   return rebound() / c.speed;
 }
 
+const char* body_name(Body b) {
+  static const char* const kNames[] = {"ball", "wall", "player"};
+  return kNames[int(b)];
+}
+
 CollisionErrors sweep_collisions(const Kernels& kernels, const PhysicsParams& params,
-                                 const std::vector<CollisionCase>& cases) {
-  static const char* const kBody[] = {"ball", "wall", "player"};
+                                 const std::vector<CollisionCase>& cases, std::vector<float>* each) {
   CollisionErrors out;
   for (const CollisionCase& c : cases) {
-    const float error = std::fabs(measured_restitution(kernels, params, c) - params.restitution);
+    const float measured = measured_restitution(kernels, params, c);
+    if (each) each->push_back(measured);
+    const float error = std::fabs(measured - params.restitution);
     ++out.collisions;
     out.within_5e3 += error <= 0.005f;
     if (error <= out.worst) continue;
@@ -71,7 +77,7 @@ CollisionErrors sweep_collisions(const Kernels& kernels, const PhysicsParams& pa
     std::ostringstream at;
     at << "diameter " << kBallKinds[c.kind_a].diameter << " on "
        << (c.other == Body::kBall ? "diameter " + std::to_string(int(kBallKinds[c.kind_b].diameter))
-                                  : std::string(kBody[int(c.other)]))
+                                  : std::string(body_name(c.other)))
        << " at " << c.speed << " m/s, phase " << c.phase;
     out.worst_case = at.str();
   }

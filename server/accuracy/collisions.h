@@ -13,6 +13,7 @@
 namespace fishtank::accuracy {
 
 enum class Body { kBall, kWall, kPlayer };
+const char* body_name(Body b);  // "ball", "wall", "player"
 
 struct CollisionCase {
   Body other;
@@ -34,8 +35,9 @@ struct CollisionErrors {
   std::string worst_case;  // which collision, in words
 };
 
+// each: when given, every case's measured restitution, in the order of cases.
 CollisionErrors sweep_collisions(const Kernels& kernels, const PhysicsParams& params,
-                                 const std::vector<CollisionCase>& cases);
+                                 const std::vector<CollisionCase>& cases, std::vector<float>* each = nullptr);
 
 // The sweep: e = 0.05, 0.3, 0.6, 0.9, 1; 0.1, 1, 5, 20 m/s; 20 phases.
 inline const std::vector<float> kSweepRestitutions{0.05f, 0.3f, 0.6f, 0.9f, 1.0f};

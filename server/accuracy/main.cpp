@@ -5,6 +5,7 @@
 // Writes to DIR (default .):
 //   rows.csv              a ball hitting a row of 1, 2 or 4 (chain, cradle): error per steps per contact
 //   collisions.csv        the worst collision of every kind per e and steps per contact (the tolerance rule)
+//   restitutions.csv      every collision's measured e at the default steps per contact
 //   accuracy.csv          scene, method, n, dt, error, CPU seconds per run
 //   accuracy-orders.csv   observed order of each scene and method, vs dt and vs CPU time
 //   stability.csv         the (k, dt) map with its measurements and class
@@ -94,6 +95,11 @@ void run_collisions(const Options& o) {
       o.quick ? std::vector<int>{10, 20} : std::vector<int>{10, 11, 12, 13, 14, 16, 20, 28, 40};
   std::ofstream csv = open_csv(o, "collisions.csv",
                                "variant,steps_per_contact,restitution,collisions,within_0.005,worst,worst_times_n2");
+  // Every collision at the default steps per contact, for the distribution beside LAMMPS's
+  // (scripts/figures-error-cost).
+  std::ofstream each_csv =
+      open_csv(o, "restitutions.csv", "variant,steps_per_contact,restitution,body,kind_a,kind_b,speed,phase,measured");
+  const int default_n = steps_per_contact(PhysicsParams{});
   std::printf("%-8s %4s %6s %10s %10s %12s\n", "variant", "n", "e", "within", "worst", "worst*n^2");
   for (int n : n_values)
     for (float e : kSweepRestitutions) {
@@ -103,8 +109,14 @@ void run_collisions(const Options& o) {
       params.tank.max = {50.0f, 100.0f, 50.0f};
       params.restitution = e;
       params.steps_per_contact = n;
-      const CollisionErrors r =
-          sweep_collisions(*o.kernels, params, every_collision(kSweepSpeeds, o.quick ? 5 : kSweepPhases));
+      const std::vector<CollisionCase> cases = every_collision(kSweepSpeeds, o.quick ? 5 : kSweepPhases);
+      std::vector<float> measured;
+      const CollisionErrors r = sweep_collisions(*o.kernels, params, cases, n == default_n ? &measured : nullptr);
+      for (std::size_t i = 0; i < measured.size(); ++i)
+        each_csv << o.kernels->variant << ',' << n << ',' << e << ',' << body_name(cases[i].other) << ','
+                 << kBallKinds[cases[i].kind_a].diameter << ','
+                 << (cases[i].other == Body::kBall ? kBallKinds[cases[i].kind_b].diameter : 0.0f) << ','
+                 << cases[i].speed << ',' << cases[i].phase << ',' << measured[i] << '\n';
       const double scaled = double(r.worst) * n * n;
       csv << o.kernels->variant << ',' << n << ',' << e << ',' << r.collisions << ',' << r.within_5e3 << ',' << r.worst
           << ',' << scaled << '\n';
