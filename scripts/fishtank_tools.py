@@ -25,6 +25,7 @@ import collections
 import csv
 import dataclasses
 import json
+import math
 import os
 import re
 import signal
@@ -297,6 +298,79 @@ def write_csv(path, rows, columns=None):
 def read_csv(path):
     with open(path, newline="") as f:
         return list(csv.DictReader(f))
+
+
+# ------------------------------------------------------------------ LAMMPS's collisions
+
+COLLISION_RESTITUTIONS = [0.05, 0.3, 0.6, 0.9, 1.0]  # the product's collision sweep (server/accuracy/collisions.h)
+COLLISION_SPEEDS = [0.1, 1.0, 5.0, 20.0]             # approach speeds, m/s, as that sweep
+COLLISION_PHASES = 20                                 # onsets spread over one step, as that sweep
+KINDS = [(1.0, 1.0), (2.0, 2.0), (3.0, 3.0)]          # diameter, mass (common/tank.h)
+
+
+def lammps_damping(k, e, m_eff):
+    """c = 2 zeta sqrt(k m_eff), as the exported scene's pair_coeff (server/export/lammps_export.cpp)."""
+    zeta = -math.log(e) / math.sqrt(math.pi ** 2 + math.log(e) ** 2) if e < 1 else 0.0
+    return 2.0 * zeta * math.sqrt(k * m_eff)
+
+
+def lammps_head_on(folder, k, t_c, steps_per_contact, restitutions=COLLISION_RESTITUTIONS):
+    """Every isolated head-on collision of the product's sweep (size pairs, speeds, onset phases; no gravity)
+    in LAMMPS's pair granular hooke, for each e and n in steps_per_contact (dt = t_c / n), in one lmp run in
+    folder (made). Rows: restitution, steps_per_contact, diameter_a, diameter_b, speed, phase, measured."""
+    os.makedirs(folder)
+    pairs = [(a, b, v, phase) for a in range(3) for b in range(a, 3) for v in COLLISION_SPEEDS
+             for phase in range(COLLISION_PHASES)]
+    side = math.ceil(math.sqrt(len(pairs)))
+    spacing = 8.0  # apart in y and z: the largest pair spans 6 m in x only
+    script = []
+    for n in steps_per_contact:
+        dt = t_c / n
+        atoms, velocities = [], []
+        for i, (a, b, v, phase) in enumerate(pairs):
+            (da, ma), (db, mb) = KINDS[a], KINDS[b]
+            gap = v * dt * (2 + phase / COLLISION_PHASES)  # the contact starts in the third step, at this phase of it
+            y, z = spacing * (i % side), spacing * (i // side)
+            for j, (kind, d, m, x, vx) in enumerate(((a, da, ma, -da / 2 - gap / 2, v / 2),
+                                                     (b, db, mb, db / 2 + gap / 2, -v / 2))):
+                atoms.append(f"{2 * i + j + 1} {kind + 1} {d} {m / (math.pi / 6 * d ** 3):.12g} {x:.12g} {y} {z}")
+                velocities.append(f"{2 * i + j + 1} {vx} 0 0 0 0 0")
+        with open(os.path.join(folder, f"data.{n}"), "w") as f:
+            f.write(f"head-on pairs, dt = t_c/{n}\n\n{len(atoms)} atoms\n3 atom types\n\n-10 10 xlo xhi\n"
+                    f"-5 {spacing * side} ylo yhi\n-5 {spacing * side} zlo zhi\n\nAtoms # sphere\n\n"
+                    + "\n".join(atoms) + "\n\nVelocities\n\n" + "\n".join(velocities) + "\n")
+        for e in restitutions:
+            script += ["clear", "units si", "atom_style sphere", "boundary f f f", "comm_modify vel yes",
+                       f"read_data data.{n}", "pair_style granular"]
+            for a in range(3):
+                for b in range(a, 3):
+                    m_eff = KINDS[a][1] * KINDS[b][1] / (KINDS[a][1] + KINDS[b][1])
+                    script.append(f"pair_coeff {a + 1} {b + 1} hooke {k} {lammps_damping(k, e, m_eff):.12g} "
+                                  "tangential linear_nohistory 0.0 0.0 damping velocity")
+            # the heaviest pair's contact lasts sqrt(3) t_c: 3 t_c covers onset, contact and parting
+            script += ["neighbor 0.5 bin", "fix integrate all nve/sphere", f"timestep {dt!r}", "thermo 0",
+                       f"run {3 * n + 10}", f"write_dump all custom final.{n}.{e} id x vx modify sort id"]
+    with open(os.path.join(folder, "in.collisions"), "w") as f:
+        f.write("\n".join(script) + "\n")
+    done = subprocess.run(["lmp", "-in", "in.collisions", "-log", "none", "-screen", "none"], cwd=folder,
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if done.returncode != 0:
+        raise RuntimeError(f"lmp failed on the collision sweep ({folder}):\n{done.stdout[-3000:]}")
+    rows = []
+    for n in steps_per_contact:
+        for e in restitutions:
+            with open(os.path.join(folder, f"final.{n}.{e}")) as f:
+                lines = f.read().splitlines()
+            start = lines.index(next(l for l in lines if l.startswith("ITEM: ATOMS"))) + 1
+            state = [tuple(map(float, l.split()[1:])) for l in lines[start:]]
+            for i, (a, b, v, phase) in enumerate(pairs):
+                (xa, va), (xb, vb) = state[2 * i], state[2 * i + 1]
+                if xb - xa < (KINDS[a][0] + KINDS[b][0]) / 2:
+                    raise RuntimeError(f"a LAMMPS pair is still in contact at the end of its run (n = {n}, e = {e})")
+                rows.append({"restitution": e, "steps_per_contact": n, "diameter_a": KINDS[a][0],
+                             "diameter_b": KINDS[b][0], "speed": v, "phase": phase / COLLISION_PHASES,
+                             "measured": (vb - va) / v})
+    return rows
 
 
 # ------------------------------------------------------------------ the machine
