@@ -274,7 +274,7 @@ class NeighbourList {
 
   static constexpr int kMaxCheckCells = 2;  // see can_check
 
-  TankBounds tank_;
+  Vec3 origin_;  // the grid's lowest corner: the tank's
   float skin_ = 0.0f;
   int nx_ = 1, ny_ = 1, nz_ = 1;
   int block_ = 1;  // cells per block in x: min(kBlockCells, nx_)

@@ -34,6 +34,7 @@ struct StepArrays {
   const Float4* player_pos = nullptr;  // x, y, z, radius
   const Float4* player_vel = nullptr;  // vx, vy, vz, 0: a kinematic body's inverse mass
   int players = 0;
+  TankBounds tank;  // the walls: the world's tank, copied for the step
   // Balls whose pos_next lies further than sqrt(stray_d2) from where the
   // lists were built have strayed: chunk [begin, end) lists its own, each once, at
   // stray_balls + begin, for the world to check (World::lists_hold).

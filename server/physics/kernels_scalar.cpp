@@ -68,9 +68,9 @@ inline Float4 contact_force(const ContactModel& m, const Float4& pi, const Float
     fz += fp.z;
   }
   const float c = contact_damping(m, vi.w);  // walls are kinematic: m_eff = m
-  fx += wall_force_1d(m, pi.x, vi.x, pi.w, vi.w, c, m.tank.min.x, m.tank.max.x);
-  fy += wall_force_1d(m, pi.y, vi.y, pi.w, vi.w, c, m.tank.min.y, m.tank.max.y);
-  fz += wall_force_1d(m, pi.z, vi.z, pi.w, vi.w, c, m.tank.min.z, m.tank.max.z);
+  fx += wall_force_1d(m, pi.x, vi.x, pi.w, vi.w, c, s.tank.min.x, s.tank.max.x);
+  fy += wall_force_1d(m, pi.y, vi.y, pi.w, vi.w, c, s.tank.min.y, s.tank.max.y);
+  fz += wall_force_1d(m, pi.z, vi.z, pi.w, vi.w, c, s.tank.min.z, s.tank.max.z);
   return Float4{fx * vi.w, fy * vi.w - m.gravity, fz * vi.w, 0.0f};
 }
 

@@ -264,7 +264,7 @@ template <class V>
 template <class V>
 [[gnu::always_inline]] inline void acceleration(const StepArrays& s, const ContactModel& m, const GroupBalls<V>& i,
                                                 V& fx, V& fy, V& fz) {
-  const TankBounds& t = m.tank;
+  const TankBounds& t = s.tank;
   const V r = i.r, reach = r + V::splat(m.lead_bound);
   const auto near_wall = (V::splat(t.min.x) + reach > i.x) | (i.x + reach > V::splat(t.max.x)) |
                          (V::splat(t.min.y) + reach > i.y) | (i.y + reach > V::splat(t.max.y)) |

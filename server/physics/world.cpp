@@ -85,7 +85,6 @@ void World::place_ball(int kind, Vec3 p, Vec3 v) {
 
 void World::restart(const TankBounds& tank, std::uint64_t seed) {
   params_.tank = tank;
-  model_.tank = tank;
   list_.configure(tank, params_.skin);
   spawner_ = Spawner(tank, seed);
   capacity_ = capacity_of(tank);
@@ -115,7 +114,7 @@ void World::spawn() {
   PhaseTimer timer(phase_seconds_.spawn);
   derive_velocities();  // while vel_half_ and vel_half_next_ are still the last pass's
   placed_.clear();
-  spawner_.place(pos_.data(), n_, player_pos_.data(), static_cast<int>(player_pos_.size()), placed_);
+  spawner_.place(params_.tank, pos_.data(), n_, player_pos_.data(), static_cast<int>(player_pos_.size()), placed_);
   if (placed_.empty()) return;
   std::uint32_t first = n_;
   resize(n_ + static_cast<std::uint32_t>(placed_.size()));

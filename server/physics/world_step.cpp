@@ -176,6 +176,7 @@ StepArrays World::arrays() {
   s.player_pos = player_pos_.data();
   s.player_vel = player_vel_.data();
   s.players = static_cast<int>(player_pos_.size());
+  s.tank = params_.tank;
   return s;
 }
 

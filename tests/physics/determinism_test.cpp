@@ -147,6 +147,7 @@ namespace {
 // order, with their lists as a kernel set builds them.
 struct DenseScene {
   ContactModel model;
+  TankBounds tank;
   AlignedVector<Float4> pos, vel_half;
   NeighbourList list;
   std::uint32_t n;
@@ -156,6 +157,7 @@ struct DenseScene {
     params.tank.min = {-6.0f, 0.0f, -6.0f};
     params.tank.max = {6.0f, 12.0f, 6.0f};
     model = make_contact_model(params);
+    tank = params.tank;
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> at(-5.0f, 5.0f), speed(-1.0f, 1.0f);
     AlignedVector<Float4> unsorted(n + kGhostSlots, kGhostPos), unsorted_vel(n + kGhostSlots, Float4{0, 0, 0, 1});
@@ -187,6 +189,7 @@ struct DenseScene {
     s.pos_next = pos_next.data();
     s.vel_half_next = vel_half_next.data();
     s.lists = layout;
+    s.tank = tank;
     for (std::size_t r = 0; r + 1 < bounds.size(); ++r)
       kernels.step(s, PrefetchPlan{}, model, bounds[r], bounds[r + 1]);
     std::vector<std::uint32_t> bits;
