@@ -8,7 +8,9 @@ PrefetchPlan prefetch_plan(const NeighbourList& list, std::uint32_t n, bool beyo
   PrefetchPlan plan;
   plan.beyond_cache = beyond_cache;
   plan.remote_rows = list.remote_rows();
+  plan.balls = n;
   plan.batches = (n + kStepBatch - 1) / kStepBatch;
+  plan.reach = list.batch_reach();
   return plan;
 }
 
@@ -17,14 +19,14 @@ PrefetchPlan prefetch_plan(const NeighbourList& list, std::uint32_t n, bool beyo
 // batches that do not need them run: the rows below its first ball at once
 // (running first the batches after those that read them), the rows around
 // its last ball over the few batches before. Larger ranges are left to the hardware.
-void add_edge_fetches(PrefetchPlan& plan, const NeighbourList& list, std::uint32_t n, std::uint32_t begin,
-                      std::uint32_t end) {
+EdgeFetches edge_fetches(const PrefetchPlan& plan, std::uint32_t begin, std::uint32_t end) {
   constexpr std::uint32_t kBelowWindow = 2, kAboveWindow = 4;  // batches
   constexpr std::uint32_t kMostRowsPerBall = 4;
-  const BatchReach* reach = list.batch_reach();
+  const BatchReach* reach = plan.reach;
   const std::uint32_t first = begin / kStepBatch, last = (end + kStepBatch - 1) / kStepBatch;
-  const std::uint32_t batches = (n + kStepBatch - 1) / kStepBatch;
-  RowFetch* fetch = plan.edge_fetch;
+  const std::uint32_t n = plan.balls, batches = plan.batches;
+  EdgeFetches edges;
+  RowFetch* fetch = edges.rows;
   const auto add = [&](RowFetch f) {
     if (f.rows_begin < f.rows_end &&
         f.rows_end - f.rows_begin <= (f.end_batch - f.first_batch) * kStepBatch * kMostRowsPerBall)
@@ -36,7 +38,7 @@ void add_edge_fetches(PrefetchPlan& plan, const NeighbourList& list, std::uint32
     while (lead < last && reach[lead].lowest < begin) ++lead;
     if (lead == last) lead = first;  // every batch reads below: no batch to run meanwhile
     const std::uint32_t lead_end = std::min(last, lead + kBelowWindow);
-    if (lead > first) plan.lead_begin = lead * kStepBatch, plan.lead_end = std::min(end, lead_end * kStepBatch);
+    if (lead > first) edges.lead_begin = lead * kStepBatch, edges.lead_end = std::min(end, lead_end * kStepBatch);
     add({lowest, begin, lead, lead_end});
   }
   if (end < n) {
@@ -47,6 +49,7 @@ void add_edge_fetches(PrefetchPlan& plan, const NeighbourList& list, std::uint32
     while (reader + 1 < last && reach[reader].highest < lowest) ++reader;
     add({lowest, highest + 1, std::max(first, reader - std::min(reader, kAboveWindow)), std::max(reader, first + 1)});
   }
+  return edges;
 }
 
 }  // namespace fishtank

@@ -172,7 +172,8 @@ class World {
   void move_players();
   void resize(std::uint32_t n);
   void set_ghost();
-  StepArrays arrays();
+  // The arrays and the contact model of the next pass; no prefetch plan.
+  StepContext context();
   // Whether the SIMD step asks for rows ahead (PrefetchPlan): from kBeyondCacheBalls balls.
   bool beyond_cache() const { return n_ >= kBeyondCacheBalls; }
   // Tunable: about where the step's arrays (some 140 bytes a ball) outgrow second-level caches; below

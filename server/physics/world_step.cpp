@@ -39,10 +39,9 @@ void World::start_from_current_state() {
   float fastest = 0.0f;
   for (std::uint32_t i = 0; i < n_; ++i) fastest = std::max(fastest, std::sqrt(squared_length3(vel_[i])));
   bound_lead(fastest);
-  StepArrays s = arrays();
-  pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int) {
-    kernels_.accelerations(s, model_, acc_.data(), begin, end);
-  });
+  const StepContext ctx = context();
+  pool_.run(n_,
+            [&](std::uint32_t begin, std::uint32_t end, int) { kernels_.accelerations(ctx, acc_.data(), begin, end); });
   next_max_d2_ = fastest_next_ = 0.0f;
   for (std::uint32_t i = 0; i < n_; ++i) next_max_d2_ = std::max(next_max_d2_, kick_drift(i, acc_[i]));
   strayed_listed_ = false;  // this pass lists no strayed balls: past skin / 2 the lists are rebuilt
@@ -62,14 +61,13 @@ void World::step() {
   PhaseTimer timer(phase_seconds_.step_pass);
   bound_lead(fastest_next_);
   std::fill(chunk_moved_.begin(), chunk_moved_.end(), ChunkMoved{});
-  StepArrays s = arrays();
-  s.stray_d2 = half_skin_d2() * kStrayMargin;  // every ball lists_hold() will count as strayed, and a hair more
-  s.stray_balls = stray_balls_.data();
-  const PrefetchPlan plan = prefetch_plan(list_, n_, beyond_cache());
+  StepContext ctx = context();
+  // Every ball lists_hold() will count as strayed, and a hair more.
+  ctx.arrays.stray_d2 = half_skin_d2() * kStrayMargin;
+  ctx.arrays.stray_balls = stray_balls_.data();
+  ctx.plan = prefetch_plan(list_, n_, beyond_cache());
   pool_.run(n_, [&](std::uint32_t begin, std::uint32_t end, int chunk) {
-    PrefetchPlan chunk_plan = plan;
-    add_edge_fetches(chunk_plan, list_, n_, begin, end);
-    chunk_moved_[chunk] = {begin, kernels_.step(s, chunk_plan, model_, begin, end)};
+    chunk_moved_[chunk] = {begin, kernels_.step(ctx, begin, end)};
   });
   next_max_d2_ = 0.0f;
   float max_v2 = 0.0f;
@@ -166,8 +164,10 @@ void World::build_lists() {
   }
 }
 
-StepArrays World::arrays() {
-  StepArrays s;
+StepContext World::context() {
+  StepContext ctx;
+  ctx.model = model_;
+  StepArrays& s = ctx.arrays;
   s.pos = pos_.data();
   s.vel_half = vel_half_.data();
   s.pos_next = pos_next_.data();
@@ -177,7 +177,7 @@ StepArrays World::arrays() {
   s.player_vel = player_vel_.data();
   s.players = static_cast<int>(player_pos_.size());
   s.tank = params_.tank;
-  return s;
+  return ctx;
 }
 
 }  // namespace fishtank

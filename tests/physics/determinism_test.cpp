@@ -13,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "server/physics/prefetch_plan.h"
 #include "server/physics/world_measures.h"
 #include "tests/physics/scenarios.h"
 
@@ -183,15 +184,17 @@ struct DenseScene {
   std::vector<std::uint32_t> step_bits(const Kernels& kernels, const std::vector<std::uint32_t>& bounds,
                                        const GroupLists& layout) const {
     AlignedVector<Float4> pos_next(n), vel_half_next(n);
-    StepArrays s;
+    StepContext ctx;
+    StepArrays& s = ctx.arrays;
     s.pos = pos.data();
     s.vel_half = vel_half.data();
     s.pos_next = pos_next.data();
     s.vel_half_next = vel_half_next.data();
     s.lists = layout;
     s.tank = tank;
-    for (std::size_t r = 0; r + 1 < bounds.size(); ++r)
-      kernels.step(s, PrefetchPlan{}, model, bounds[r], bounds[r + 1]);
+    ctx.plan = prefetch_plan(list, n, false);  // each range asks for its edge rows, as a world's chunks do
+    ctx.model = model;
+    for (std::size_t r = 0; r + 1 < bounds.size(); ++r) kernels.step(ctx, bounds[r], bounds[r + 1]);
     std::vector<std::uint32_t> bits;
     for (const AlignedVector<Float4>* out : {&pos_next, &vel_half_next})
       for (const Float4& f : *out)
