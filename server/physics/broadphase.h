@@ -77,7 +77,7 @@ inline void write_group_record(const Float4* pos, const std::uint32_t* group, st
 }
 
 // The balls a batch's lists name lie in [lowest, highest] (none: lowest > highest); near a chunk's
-// edge they include the next chunk's, which the world asks for ahead (World::add_edge_fetches).
+// edge they include the next chunk's, which the step asks for ahead (edge_fetches, prefetch_plan.h).
 struct BatchReach {
   std::uint32_t lowest = std::numeric_limits<std::uint32_t>::max(), highest = 0;
   void add(std::uint32_t j) {
