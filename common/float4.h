@@ -15,6 +15,9 @@ struct alignas(16) Float4 {
 };
 static_assert(sizeof(Float4) == 16 && alignof(Float4) == 16);
 
+// The squared length of x, y, z: a velocity row's squared speed.
+inline float squared_length3(const Float4& v) { return v.x * v.x + v.y * v.y + v.z * v.z; }
+
 // Cache-line aligned storage, so a thread's chunk never starts mid-line and the
 // arrays never share a line with unrelated data.
 template <class T>

@@ -1,6 +1,6 @@
 #pragma once
 // How deep balls may sink into each other before the server and the HUD warn
-// (World::overlap_warning, Snapshot.max_overlap): beyond it they visibly do,
+// (overlap_warning in world_measures.h, Snapshot.max_overlap): beyond it they visibly do,
 // and the stiffness is too soft for the load.
 
 namespace fishtank {

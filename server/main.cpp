@@ -19,6 +19,7 @@
 #include "server/export/trajectory_recorder.h"
 #include "server/net/network_service.h"
 #include "server/options.h"
+#include "server/physics/world_measures.h"
 #include "server/realtime_loop.h"
 #include "server/scenes/active_scene.h"
 
@@ -69,7 +70,7 @@ bool apply_max_balls(fishtank::World& world, const fishtank::ServerOptions& o) {
 
 int run_bench(const fishtank::ServerOptions& o) {
   fishtank::World world(o.physics, kKernels, o.threads, o.bench_spec.scene.seed);
-  world.set_thread_tuning(!o.fixed_threads);
+  fishtank::TunedStepper stepper(world, !o.fixed_threads);
   if (!apply_max_balls(world, o)) return 2;
   // A benchmark times the count asked for or nothing: refused before any is poured.
   if (o.bench_spec.scene.name == "tank" && o.bench_spec.scene.balls > world.max_balls()) {
@@ -83,13 +84,13 @@ int run_bench(const fishtank::ServerOptions& o) {
     std::cerr << "fishtank-server: --bench refuses: " << refusal << "\n";
     return 2;
   }
-  fishtank::SettleReport settled = fishtank::settle(world, o.bench_spec.scene);
+  fishtank::SettleReport settled = fishtank::settle(stepper, o.bench_spec.scene);
   if (!settled.settled)
     std::cerr << "fishtank-server: warning: not at rest after " << settled.sim_seconds
               << " simulated seconds; timing anyway\n";
   std::cerr << "timing " << o.bench_spec.steps << " steps of " << world.ball_count() << " balls\n";
-  nlohmann::json report = fishtank::time_steps(world, o.bench_spec, settled);
-  if (const std::string warning = world.overlap_warning(); !warning.empty())
+  nlohmann::json report = fishtank::time_steps(stepper, o.bench_spec, settled);
+  if (const std::string warning = overlap_warning(world); !warning.empty())
     std::cerr << "fishtank-server: warning: " << warning << "\n";
   std::cout << report.dump(2) << std::endl;
   return write_final_state(world, o, recorder);
@@ -165,7 +166,7 @@ int run_server(const fishtank::ServerOptions& o) {
   fishtank::PhysicsParams params = o.physics;
   params.tank = scene.first_tank();
   fishtank::World world(params, kKernels, o.threads, o.bench_spec.scene.seed);
-  world.set_thread_tuning(!o.fixed_threads);
+  fishtank::TunedStepper stepper(world, !o.fixed_threads);
   if (!apply_max_balls(world, o)) return 2;
   if (std::string refusal = scene.start(world); !refusal.empty()) std::cerr << "fishtank-server: " << refusal << "\n";
   fishtank::RunControl control;
@@ -199,14 +200,14 @@ int run_server(const fishtank::ServerOptions& o) {
     if (const std::string note = recorder.at_step_boundary(w); !note.empty()) spdlog::warn("{}", note);
   };
   loop.on_status = [&network, &control, &scene, cores](const fishtank::World& w, const fishtank::LoopStatus& s) {
-    const std::string warning = w.overlap_warning();
+    const std::string warning = overlap_warning(w);
     std::fprintf(
         stderr, "t = %7.1f s  balls %5u (+%u queued)  %6.0f steps/s  load %5.1f %% on %s  %s  scene %s%s%s%s\n",
         w.time(), w.ball_count(), w.pending(), s.steps_per_s, 100.0 * s.load,
         threads_text(s.threads, cores, s.crowding_cores).c_str(), network.status().c_str(), scene.name().c_str(),
         pace_text(s, control).c_str(), warning.empty() ? "" : "  WARNING: ", warning.c_str());
   };
-  fishtank::run_realtime(world, loop, g_stop);
+  fishtank::run_realtime(stepper, loop, g_stop);
   std::cerr << "fishtank-server: stopped after " << world.steps() << " steps, " << world.ball_count() << " balls\n";
   return write_final_state(world, o, recorder);
 }

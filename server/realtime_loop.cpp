@@ -19,7 +19,32 @@ double seconds_between(Clock::time_point from, Clock::time_point to) {
 }
 }  // namespace
 
-void run_realtime(World& world, const LoopOptions& options, const std::atomic<bool>& stop) {
+TunedStepper::TunedStepper(World& world, bool tune) : world_(world), epoch_(Clock::now()) {
+  if (!tune) return;
+  tuner_.emplace(world.threads());
+  world.set_thread_limit(tuner_->threads());
+}
+
+void TunedStepper::step() {
+  one_thread_steps_ += world_.thread_limit() == 1;
+  if (!tuner_) {
+    world_.step();
+    return;
+  }
+  const Clock::time_point start = Clock::now();
+  world_.step();
+  const Clock::time_point end = Clock::now();
+  const double now = seconds_between(epoch_, end);
+  machine_load_.update(now);  // after the step's clock: a reading is not a step's cost
+  using Load = ThreadTuner::Load;
+  const Load load = !machine_load_.room_for(world_.threads()) ? Load::kOneThread
+                    : machine_load_.shared_per_thread()       ? Load::kEveryThread
+                                                              : Load::kMeasure;
+  world_.set_thread_limit(tuner_->record(seconds_between(start, end), 1, now, load));
+}
+
+void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::atomic<bool>& stop) {
+  World& world = stepper.world();
   const double dt = world.dt();
   RunControl real_time;
   RunControl& control = options.control ? *options.control : real_time;
@@ -51,17 +76,17 @@ void run_realtime(World& world, const LoopOptions& options, const std::atomic<bo
     std::uint64_t batch_steps = 0;
     if (control.paused) {
       for (; control.steps_to_run > 0 && within_budget(batch_steps); --control.steps_to_run, ++batch_steps)
-        world.step();
+        stepper.step();
     } else {
       for (; sim_clock + wall_per_step <= now && within_budget(batch_steps); sim_clock += wall_per_step, ++batch_steps)
-        world.step();
+        stepper.step();
     }
     const Clock::time_point busy_end = Clock::now();
     const double busy = seconds_between(busy_start, busy_end);
     window_busy += busy;
     window_steps += batch_steps;
-    status.threads = world.stepping_threads();
-    status.crowding_cores = world.crowding_cores();
+    status.threads = stepper.threads();
+    status.crowding_cores = stepper.crowding_cores();
 
     const double window = seconds_between(window_start, busy_end);
     if (window >= options.status_interval) {

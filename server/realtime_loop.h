@@ -4,13 +4,43 @@
 // physics cannot keep real time the world runs in slow motion while
 // snapshots and commands keep their rate. Reports steps actually done per
 // second, the load (the busy fraction of the wall time) and the time scale.
+// It picks the thread count the steps use as the machine's load changes
+// (TunedStepper), which the benchmark's unpaced steps use too.
 
 #include <atomic>
+#include <chrono>
+#include <cstdint>
 #include <functional>
+#include <optional>
 
+#include "server/machine_load.h"
 #include "server/physics/world.h"
+#include "server/thread_tuner.h"
 
 namespace fishtank {
+
+// Steps a world, choosing before each step between every worker thread and one
+// as the machine's load and the steps' measured cost say (ThreadTuner,
+// MachineLoad); untuned, on the world's thread limit. Results never depend on it.
+class TunedStepper {
+ public:
+  TunedStepper(World& world, bool tune);
+
+  World& world() const { return world_; }
+  void step();
+  // The threads the steps use: the tuner's choice between its probes.
+  int threads() const { return tuner_ ? tuner_->chosen() : world_.thread_limit(); }
+  // While tuning: the cores work in other sessions keeps busy (MachineLoad::crowding), below 0 until measured.
+  double crowding_cores() const { return tuner_ && machine_load_.measured() ? machine_load_.crowding() : -1.0; }
+  std::uint64_t steps_on_one_thread() const { return one_thread_steps_; }
+
+ private:
+  World& world_;
+  std::optional<ThreadTuner> tuner_;
+  MachineLoad machine_load_;
+  std::chrono::steady_clock::time_point epoch_;
+  std::uint64_t one_thread_steps_ = 0;
+};
 
 struct LoopStatus {
   double steps_per_s = 0.0;
@@ -52,6 +82,6 @@ struct LoopOptions {
   RunControl* control = nullptr;
 };
 
-void run_realtime(World& world, const LoopOptions& options, const std::atomic<bool>& stop);
+void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::atomic<bool>& stop);
 
 }  // namespace fishtank

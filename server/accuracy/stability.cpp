@@ -5,6 +5,7 @@
 
 #include "server/accuracy/scenes.h"
 #include "server/physics/world.h"
+#include "server/physics/world_measures.h"
 
 namespace fishtank::accuracy {
 namespace {
@@ -50,17 +51,17 @@ PileResult run_pile(double k, double dt, const Kernels& kernels) {
             0, {1.25f * x + 0.1f * std::sin(1.7f * i), 0.6f + 1.25f * y, 1.25f * z + 0.1f * std::cos(2.3f * i)},
             {0.0f, 0.0f, 0.0f});
 
-  const double start = world.kinetic_energy() + world.potential_energy();
+  const double start = kinetic_energy(world) + potential_energy(world);
   double ratio = 1.0;
   const long steps = std::lround(std::ceil(kPileSeconds / dt));
   for (long s = 1; s <= steps; ++s) {
     world.step();
     if (s % 16 != 0 && s != steps) continue;
     if (lost_balls(world) > 0) return {false, NAN, NAN};
-    ratio = std::max(ratio, (world.kinetic_energy() + world.potential_energy()) / start);
+    ratio = std::max(ratio, (kinetic_energy(world) + potential_energy(world)) / start);
     if (ratio > kBlowUp) break;
   }
-  return {true, world.max_overlap_fraction(), ratio};
+  return {true, max_overlap_fraction(world), ratio};
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "server/bench/line_transfer.h"
+#include "server/physics/world_measures.h"
 
 namespace fishtank {
 
@@ -18,14 +19,15 @@ double peak_rss_mib() {
 }
 }  // namespace
 
-nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleReport& settle) {
+nlohmann::json time_steps(TunedStepper& stepper, const BenchSpec& spec, const SettleReport& settle) {
+  World& world = stepper.world();
   // The cores' placement before and after: it moves the figures of scenes
   // whose threads share lines (line_transfer.h).
   const std::optional<LineTransfer> transfer_before = time_line_transfer(world.cpus());
   const PhaseSeconds before = world.phase_seconds();
   const std::uint64_t rebuilds_before = world.rebuilds(), kept_before = world.lists_kept_by_checks();
   world.reset_thread_shares();
-  const std::uint64_t one_thread_before = world.steps_on_one_thread();
+  const std::uint64_t one_thread_before = stepper.steps_on_one_thread();
   // A shared machine's noise comes in bursts: timing several windows and
   // reporting the median keeps one burst from deciding the figure.
   const std::uint32_t windows = static_cast<std::uint32_t>(std::clamp<std::uint64_t>(spec.windows, 1, spec.steps));
@@ -34,7 +36,7 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   for (std::uint32_t w = 0; w < windows; ++w) {
     const std::uint64_t until = spec.steps * (w + 1) / windows;
     const auto start = std::chrono::steady_clock::now();
-    for (; done < until; ++done) world.step();
+    for (; done < until; ++done) stepper.step();
     window_seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   double seconds = 0.0;
@@ -60,10 +62,10 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   j["thread_shares"] = world.thread_shares();  // of the items the timed steps' passes computed
   // The thread tuner's choice: the fraction of the timed steps taken on one thread.
   j["one_thread_step_fraction"] =
-      double(world.steps_on_one_thread() - one_thread_before) / std::max<std::uint64_t>(1, spec.steps);
+      double(stepper.steps_on_one_thread() - one_thread_before) / std::max<std::uint64_t>(1, spec.steps);
   // Cores work in other sessions kept busy at the end (MachineLoad), which keeps the steps on one thread;
   // null untuned.
-  if (const double crowding = world.crowding_cores(); crowding >= 0.0)
+  if (const double crowding = stepper.crowding_cores(); crowding >= 0.0)
     j["crowding_cores"] = crowding;
   else
     j["crowding_cores"] = nullptr;
@@ -82,16 +84,16 @@ nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleRepor
   j["dt_from_tolerance"] = world.params().steps_per_contact == 0 && world.params().dt == 0.0f;
   j["k"] = world.params().stiffness;
   j["restitution"] = world.params().restitution;
-  j["max_overlap"] = world.max_overlap_fraction();
-  j["overlap_warning"] = world.overlap_warning();  // empty while the largest overlap is within kOverlapWarning
-  j["pile_top"] = world.pile_top();
+  j["max_overlap"] = max_overlap_fraction(world);
+  j["overlap_warning"] = overlap_warning(world);  // empty while the largest overlap is within kOverlapWarning
+  j["pile_top"] = pile_top(world);
   j["tank"] = {{"min", {tank.min.x, tank.min.y, tank.min.z}}, {"max", {tank.max.x, tank.max.y, tank.max.z}}};
-  j["mean_neighbours"] = world.mean_neighbours();
+  j["mean_neighbours"] = mean_neighbours(world);
   j["rebuilds"] = world.rebuilds() - rebuilds_before;
   // Steps that kept the lists after checking the balls that moved past skin/2.
   j["lists_kept_after_check"] = world.lists_kept_by_checks() - kept_before;
-  j["kinetic_energy_per_ball"] = world.ball_count() ? world.kinetic_energy() / world.ball_count() : 0.0;
-  j["max_speed"] = world.max_speed();  // the fastest ball, m/s
+  j["kinetic_energy_per_ball"] = world.ball_count() ? kinetic_energy(world) / world.ball_count() : 0.0;
+  j["max_speed"] = max_speed(world);  // the fastest ball, m/s
   j["settle"] = {{"settled", settle.settled},
                  {"sim_seconds", settle.sim_seconds},
                  {"wall_seconds", settle.wall_seconds},

@@ -18,6 +18,6 @@ struct BenchSpec {
 };
 
 // Runs the timed part on an already settled world and returns the report.
-nlohmann::json time_steps(World& world, const BenchSpec& spec, const SettleReport& settle);
+nlohmann::json time_steps(TunedStepper& stepper, const BenchSpec& spec, const SettleReport& settle);
 
 }  // namespace fishtank

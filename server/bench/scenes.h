@@ -7,6 +7,7 @@
 
 #include <cstdint>
 
+#include "server/realtime_loop.h"
 #include "server/scenes/scene_presets.h"
 
 namespace fishtank {
@@ -20,7 +21,7 @@ struct SettleReport {
 
 // Steps until every ball is in and the pile is at rest (mean kinetic energy
 // per ball below kRestEnergy), or the time limit passes. Prints progress on stderr.
-SettleReport settle(World& world, const SceneSpec& spec);
+SettleReport settle(TunedStepper& stepper, const SceneSpec& spec);
 
 // At rest, as LAMMPS runs usually take it. Not "every ball below some speed":
 // a frictionless ball can slide along the floor for minutes.

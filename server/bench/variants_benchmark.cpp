@@ -43,7 +43,8 @@ const std::vector<fishtank::BallView>& settled_tank() {
     fishtank::SceneSpec spec;  // tank, 6000 balls
     World world(fishtank::PhysicsParams{}, fishtank::kSseKernels, fishtank::WorkerPool::hardware_threads(), 1);
     fishtank::populate(world, spec);
-    const fishtank::SettleReport report = fishtank::settle(world, spec);
+    fishtank::TunedStepper untuned(world, false);
+    const fishtank::SettleReport report = fishtank::settle(untuned, spec);
     // scripts/callgrind-step switches instrumentation on at this line.
     std::fprintf(stderr, "settled: %u balls, %.1f simulated s, %s\n", world.ball_count(), report.sim_seconds,
                  report.settled ? "at rest" : "time limit reached");
@@ -189,7 +190,8 @@ World& wide_world(std::uint32_t balls) {
     params.tank = fishtank::scene_tank(spec);
     world = std::make_unique<World>(params, fishtank::kSseKernels, fishtank::WorkerPool::hardware_threads(), 1);
     fishtank::populate(*world, spec);
-    fishtank::settle(*world, spec);
+    fishtank::TunedStepper untuned(*world, false);
+    fishtank::settle(untuned, spec);
   }
   return *world;
 }

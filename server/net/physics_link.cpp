@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include "server/physics/world_measures.h"
+
 namespace fishtank::net {
 
 namespace {
@@ -114,10 +116,9 @@ void PhysicsLink::refresh_figures(const World& world, Clock::time_point now) {
   if (now < next_figures_ && figures_start_ == scene_.start_count()) return;
   next_figures_ = now + kFiguresPeriod;
   figures_start_ = scene_.start_count();
-  kinetic_energy_per_ball_ =
-      world.ball_count() ? static_cast<float>(world.kinetic_energy() / world.ball_count()) : 0.0f;
-  contacts_ = world.contact_count();
-  max_overlap_ = world.max_overlap_fraction();
+  kinetic_energy_per_ball_ = world.ball_count() ? static_cast<float>(kinetic_energy(world) / world.ball_count()) : 0.0f;
+  contacts_ = contact_count(world);
+  max_overlap_ = max_overlap_fraction(world);
 }
 
 void PhysicsLink::publish_snapshot(const World& world, const LoopStatus& status) {

@@ -5,7 +5,7 @@
 namespace fishtank {
 
 void NeighbourList::configure(const TankBounds& tank, float skin) {
-  tank_ = tank;
+  origin_ = tank.min;
   skin_ = skin;
   const float min_edge = kMaxBallDiameter + skin;
   Vec3 size = tank.size();
@@ -28,8 +28,8 @@ CellCoord NeighbourList::cell_of(const Float4& p) const {
     const float c = std::max(0.0f, (pos - lo) * inv_edge);
     return static_cast<std::int32_t>(std::min(c, float(cells - 1)));
   };
-  return {axis(p.x, tank_.min.x, inv_edge_.x, nx_), axis(p.y, tank_.min.y, inv_edge_.y, ny_),
-          axis(p.z, tank_.min.z, inv_edge_.z, nz_)};
+  return {axis(p.x, origin_.x, inv_edge_.x, nx_), axis(p.y, origin_.y, inv_edge_.y, ny_),
+          axis(p.z, origin_.z, inv_edge_.z, nz_)};
 }
 
 void NeighbourList::sort(const Float4* pos, std::uint32_t n, std::vector<std::uint32_t>& order) {
@@ -135,7 +135,7 @@ ListBuild NeighbourList::build_view(const Float4* pos, std::uint32_t n) {
   ListBuild b{};
   b.cell_start = cell_start_.data();
   b.nx = nx_, b.ny = ny_, b.nz = nz_, b.block = block_;
-  b.origin = tank_.min, b.edge = edge_, b.skin = skin_;
+  b.origin = origin_, b.edge = edge_, b.skin = skin_;
   b.pos = pos, b.n = n, b.ball_cell = sorted_cell_.data();
   b.x = x, b.y = y, b.z = z, b.r = r;
   b.neighbours = neighbours_.get(), b.counts = counts_.data(), b.stride = stride_;

@@ -77,7 +77,7 @@ inline void write_group_record(const Float4* pos, const std::uint32_t* group, st
 }
 
 // The balls a batch's lists name lie in [lowest, highest] (none: lowest > highest); near a chunk's
-// edge they include the next chunk's, which the world asks for ahead (World::add_edge_fetches).
+// edge they include the next chunk's, which the step asks for ahead (edge_fetches, prefetch_plan.h).
 struct BatchReach {
   std::uint32_t lowest = std::numeric_limits<std::uint32_t>::max(), highest = 0;
   void add(std::uint32_t j) {
@@ -274,7 +274,7 @@ class NeighbourList {
 
   static constexpr int kMaxCheckCells = 2;  // see can_check
 
-  TankBounds tank_;
+  Vec3 origin_;  // the grid's lowest corner: the tank's
   float skin_ = 0.0f;
   int nx_ = 1, ny_ = 1, nz_ = 1;
   int block_ = 1;  // cells per block in x: min(kBlockCells, nx_)

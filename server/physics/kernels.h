@@ -34,6 +34,7 @@ struct StepArrays {
   const Float4* player_pos = nullptr;  // x, y, z, radius
   const Float4* player_vel = nullptr;  // vx, vy, vz, 0: a kinematic body's inverse mass
   int players = 0;
+  TankBounds tank;  // the walls: the world's tank, copied for the step
   // Balls whose pos_next lies further than sqrt(stray_d2) from where the
   // lists were built have strayed: chunk [begin, end) lists its own, each once, at
   // stray_balls + begin, for the world to check (World::lists_hold).
@@ -53,9 +54,22 @@ struct RowFetch {
 struct PrefetchPlan {
   bool beyond_cache = false;                // ask for rows kPrefetchBatches ahead, and the remote rows
   const RemoteRows* remote_rows = nullptr;  // per batch, `batches` of them
-  std::uint32_t batches = 0;
-  RowFetch edge_fetch[2] = {};                 // rows that the neighbouring chunks' threads write or read too
-  std::uint32_t lead_begin = 0, lead_end = 0;  // batches run first, while edge_fetch[0] arrives
+  std::uint32_t balls = 0, batches = 0;     // n, and n / kStepBatch rounded up
+  const BatchReach* reach = nullptr;        // per batch, the rows its lists read: each chunk's EdgeFetches
+};
+
+// What one chunk of a SIMD step asks for ahead besides the PrefetchPlan (prefetch_plan.h).
+struct EdgeFetches {
+  RowFetch rows[2] = {};                       // rows that the neighbouring chunks' threads write or read too
+  std::uint32_t lead_begin = 0, lead_end = 0;  // batches run first, while rows[0] arrives
+};
+
+// Everything a step pass reads, built once per step by the world (World::step) and
+// passed whole through every layer of the kernels, as Box2D's b2StepContext is.
+struct StepContext {
+  StepArrays arrays;
+  PrefetchPlan plan;
+  ContactModel model;
 };
 
 // How far the balls of a chunk moved from where the lists were built.
@@ -72,11 +86,9 @@ struct Kernels {
   std::uint32_t list_lanes;  // balls per group in the lists' layout (broadphase.h)
   // Each pass takes balls [begin, end) from batch edges (kStepBatch): the lists are laid out per batch.
   // The step returns how far the balls moved since the build, which says when to rebuild.
-  Moved (*step)(const StepArrays& s, const PrefetchPlan& plan, const ContactModel& m, std::uint32_t begin,
-                std::uint32_t end);
+  Moved (*step)(const StepContext& ctx, std::uint32_t begin, std::uint32_t end);
   // a = F(pos, vel_half) / m + g only, into acc: for balls placed in contact, whose forces are not known yet.
-  void (*accelerations)(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin,
-                        std::uint32_t end);
+  void (*accelerations)(const StepContext& ctx, Float4* acc, std::uint32_t begin, std::uint32_t end);
   // Neighbour lists (see broadphase.h). Returns the longest.
   std::uint32_t (*build_lists)(const ListBuild& b, std::uint32_t begin, std::uint32_t end);
 };

@@ -40,9 +40,10 @@ inline Float4 contact_force(const ContactModel& m, const Float4& pi, const Float
 }
 
 // The sum of the contact forces of ball i's neighbours, in list order.
-[[gnu::always_inline]] inline Float4 neighbour_forces(const StepArrays& s, const BallLists& lists,
-                                                      const ContactModel& m, std::uint32_t i,
+[[gnu::always_inline]] inline Float4 neighbour_forces(const StepContext& ctx, const BallLists& lists, std::uint32_t i,
                                                       const std::uint32_t* list) {
+  const StepArrays& s = ctx.arrays;
+  const ContactModel& m = ctx.model;
   const Float4 pi = s.pos[i];
   const Float4 vi = s.vel_half[i];
   float fx = 0.0f, fy = 0.0f, fz = 0.0f;
@@ -56,8 +57,9 @@ inline Float4 contact_force(const ContactModel& m, const Float4& pi, const Float
 }
 
 // a = F / m + g for ball i: its neighbours' forces f, plus player spheres and walls.
-[[gnu::always_inline]] inline Float4 acceleration(const StepArrays& s, const ContactModel& m, std::uint32_t i,
-                                                  const Float4& f) {
+[[gnu::always_inline]] inline Float4 acceleration(const StepContext& ctx, std::uint32_t i, const Float4& f) {
+  const StepArrays& s = ctx.arrays;
+  const ContactModel& m = ctx.model;
   const Float4 pi = s.pos[i];
   const Float4 vi = s.vel_half[i];
   float fx = f.x, fy = f.y, fz = f.z;
@@ -68,20 +70,20 @@ inline Float4 contact_force(const ContactModel& m, const Float4& pi, const Float
     fz += fp.z;
   }
   const float c = contact_damping(m, vi.w);  // walls are kinematic: m_eff = m
-  fx += wall_force_1d(m, pi.x, vi.x, pi.w, vi.w, c, m.tank.min.x, m.tank.max.x);
-  fy += wall_force_1d(m, pi.y, vi.y, pi.w, vi.w, c, m.tank.min.y, m.tank.max.y);
-  fz += wall_force_1d(m, pi.z, vi.z, pi.w, vi.w, c, m.tank.min.z, m.tank.max.z);
+  fx += wall_force_1d(m, pi.x, vi.x, pi.w, vi.w, c, s.tank.min.x, s.tank.max.x);
+  fy += wall_force_1d(m, pi.y, vi.y, pi.w, vi.w, c, s.tank.min.y, s.tank.max.y);
+  fz += wall_force_1d(m, pi.z, vi.z, pi.w, vi.w, c, s.tank.min.z, s.tank.max.z);
   return Float4{fx * vi.w, fy * vi.w - m.gravity, fz * vi.w, 0.0f};
 }
 
 // One pair at a time reads its rows in order: the prefetch plan is the SIMD twins'.
-Moved step(const StepArrays& arrays, const PrefetchPlan&, const ContactModel& model, std::uint32_t begin,
-           std::uint32_t end) {
+Moved step(const StepContext& context, std::uint32_t begin, std::uint32_t end) {
   // Local copies: stores through the output pointers cannot change them, so
   // pointers and constants stay in registers.
-  const StepArrays s = arrays;
+  const StepContext ctx = context;
+  const StepArrays& s = ctx.arrays;
   const BallLists lists = std::get<BallLists>(s.lists);
-  const ContactModel m = model;
+  const ContactModel& m = ctx.model;
   Moved moved;
   // A batch's neighbour sums first, then the rest per ball: one loop doing
   // both keeps the wall and integration values live across the neighbour loop.
@@ -90,9 +92,9 @@ Moved step(const StepArrays& arrays, const PrefetchPlan&, const ContactModel& mo
     last_of_batch = batch_end(batch, end);
     const std::uint32_t* list = lists.neighbours + std::size_t(batch) * lists.stride;
     for (std::uint32_t i = batch; i < last_of_batch; list += lists.counts[i++])
-      pair_force[i - batch] = neighbour_forces(s, lists, m, i, list);
+      pair_force[i - batch] = neighbour_forces(ctx, lists, i, list);
     for (std::uint32_t i = batch; i < last_of_batch; ++i) {
-      const Float4 a = acceleration(s, m, i, pair_force[i - batch]);
+      const Float4 a = acceleration(ctx, i, pair_force[i - batch]);
       const Float4 vh = s.vel_half[i];
       const Float4 v{vh.x + a.x * m.half_dt, vh.y + a.y * m.half_dt, vh.z + a.z * m.half_dt, vh.w};
       const float d2 = kick_drift(m, v, s.pos[i], a, lists.at_build[i], s.vel_half_next[i], s.pos_next[i]);
@@ -105,12 +107,12 @@ Moved step(const StepArrays& arrays, const PrefetchPlan&, const ContactModel& mo
   return moved;
 }
 
-void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin, std::uint32_t end) {
-  const BallLists& lists = std::get<BallLists>(s.lists);
+void accelerations(const StepContext& ctx, Float4* acc, std::uint32_t begin, std::uint32_t end) {
+  const BallLists& lists = std::get<BallLists>(ctx.arrays.lists);
   for (std::uint32_t batch = begin; batch < end; batch += kStepBatch) {
     const std::uint32_t* list = lists.neighbours + std::size_t(batch) * lists.stride;
     for (std::uint32_t i = batch; i < batch_end(batch, end); list += lists.counts[i++])
-      acc[i] = acceleration(s, m, i, neighbour_forces(s, lists, m, i, list));
+      acc[i] = acceleration(ctx, i, neighbour_forces(ctx, lists, i, list));
   }
 }
 

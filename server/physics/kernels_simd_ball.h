@@ -15,6 +15,7 @@
 #include "common/simd/sse_float4.h"
 #include "server/physics/contact_law.h"
 #include "server/physics/kernels.h"
+#include "server/physics/prefetch_plan.h"
 
 namespace fishtank {
 namespace {
@@ -204,9 +205,10 @@ struct GroupBalls {
 // made once per group; a block with a contact starting or ending takes the
 // whole law (contact_law.h). Both give the scalar twin's value to float rounding.
 template <class V>
-[[gnu::always_inline]] inline void neighbour_forces(const StepArrays& s, const ContactModel& m,
-                                                    const std::uint32_t* block, std::uint32_t blocks,
-                                                    const GroupBalls<V>& i, V& fx, V& fy, V& fz) {
+[[gnu::always_inline]] inline void neighbour_forces(const StepContext& ctx, const std::uint32_t* block,
+                                                    std::uint32_t blocks, const GroupBalls<V>& i, V& fx, V& fy, V& fz) {
+  const StepArrays& s = ctx.arrays;
+  const ContactModel& m = ctx.model;
   // A neighbour's kind is known by its 1 / mass: c and c / (1 + beta) of each pair, once per group.
   V kind_inv_m[kKindCount], kind_c[kKindCount], kind_damping[kKindCount];
   for (int k = 0; k < kKindCount; ++k) {
@@ -262,9 +264,10 @@ template <class V>
 // a = F / m + g for a group's balls: their neighbours' forces f, plus player
 // spheres and walls, added in the scalar twin's order.
 template <class V>
-[[gnu::always_inline]] inline void acceleration(const StepArrays& s, const ContactModel& m, const GroupBalls<V>& i,
-                                                V& fx, V& fy, V& fz) {
-  const TankBounds& t = m.tank;
+[[gnu::always_inline]] inline void acceleration(const StepContext& ctx, const GroupBalls<V>& i, V& fx, V& fy, V& fz) {
+  const StepArrays& s = ctx.arrays;
+  const ContactModel& m = ctx.model;
+  const TankBounds& t = s.tank;
   const V r = i.r, reach = r + V::splat(m.lead_bound);
   const auto near_wall = (V::splat(t.min.x) + reach > i.x) | (i.x + reach > V::splat(t.max.x)) |
                          (V::splat(t.min.y) + reach > i.y) | (i.y + reach > V::splat(t.max.y)) |
@@ -317,9 +320,10 @@ inline void prefetch(const void* base, std::size_t bytes) {
 // This group's share of the rows, records and lists of the batch
 // kPrefetchBatches ahead, and of that batch's remote rows.
 template <std::uint32_t kCount>
-[[gnu::always_inline]] inline void prefetch_batch_ahead(const StepArrays& s, const GroupLists& lists,
-                                                        const PrefetchPlan& plan, std::uint32_t batch,
-                                                        std::uint32_t share) {
+[[gnu::always_inline]] inline void prefetch_batch_ahead(const StepContext& ctx, const GroupLists& lists,
+                                                        std::uint32_t batch, std::uint32_t share) {
+  const StepArrays& s = ctx.arrays;
+  const PrefetchPlan& plan = ctx.plan;
   const std::size_t ahead = std::size_t(batch) + kPrefetchBatches * kStepBatch;
   const std::size_t rows = (ahead + share * kCount) * sizeof(Float4);
   for (std::size_t line = rows; line < rows + kCount * sizeof(Float4); line += kCacheLine) {
@@ -365,10 +369,10 @@ template <std::uint32_t kCount>
 // A batch's groups, one ball per lane: a = F / m + g, then per_group(at, i, ax, ay, az, record)
 // does the rest for the balls at list entries `at`.
 template <class V, class PerGroup>
-[[gnu::always_inline]] inline void for_each_group_of_batch(const StepArrays& s, const GroupLists& lists,
-                                                           const PrefetchPlan& plan, const ContactModel& m,
-                                                           std::uint32_t batch, std::uint32_t end,
-                                                           PerGroup& per_group) {
+[[gnu::always_inline]] inline void for_each_group_of_batch(const StepContext& ctx, const GroupLists& lists,
+                                                           const EdgeFetches& edges, std::uint32_t batch,
+                                                           std::uint32_t end, PerGroup& per_group) {
+  const StepArrays& s = ctx.arrays;
   constexpr std::uint32_t kCount = Lanes<V>::kCount;
   const std::uint32_t* block = lists.neighbours + std::size_t(batch) * lists.stride;
   const std::uint32_t groups = grouped_length(batch_end(batch, end) - batch, kCount) / kCount;
@@ -376,51 +380,52 @@ template <class V, class PerGroup>
   const std::uint32_t* record = lists.records + 4 * std::size_t(batch);
   // Decided once per batch: most batches are in no fetch's window (all, on one thread).
   const std::uint32_t batch_number = batch / kStepBatch;
-  const bool fetching = in_window(plan.edge_fetch[0], batch_number) || in_window(plan.edge_fetch[1], batch_number);
+  const bool fetching = in_window(edges.rows[0], batch_number) || in_window(edges.rows[1], batch_number);
   for (std::uint32_t share = 0; share < groups; ++share, record += 4 * kCount) {
-    if (plan.beyond_cache) prefetch_batch_ahead<kCount>(s, lists, plan, batch, share);
+    if (ctx.plan.beyond_cache) prefetch_batch_ahead<kCount>(ctx, lists, batch, share);
     if (fetching)
-      for (const RowFetch& f : plan.edge_fetch) fetch_rows<kCount>(s, f, batch_number, share);
+      for (const RowFetch& f : edges.rows) fetch_rows<kCount>(s, f, batch_number, share);
     const std::uint32_t blocks = group_blocks[share];
     const std::uint32_t* const at = record + 3 * kCount;  // the group's list entries
     GroupBalls<V> i;
     Lanes<V>::load(s.pos, at, i.x, i.y, i.z, i.r);
     Lanes<V>::load(s.vel_half, at, i.vx, i.vy, i.vz, i.inv_m);
     V ax, ay, az;
-    neighbour_forces(s, m, block, blocks, i, ax, ay, az);
-    acceleration(s, m, i, ax, ay, az);
+    neighbour_forces(ctx, block, blocks, i, ax, ay, az);
+    acceleration(ctx, i, ax, ay, az);
     per_group(at, i, ax, ay, az, record);
     block += std::size_t(blocks) * kCount;
   }
 }
 
-// The chunk's lead batches first (PrefetchPlan::lead_begin), then the others in order.
+// The chunk's lead batches first (EdgeFetches::lead_begin), then the others in order.
 template <class V, class PerGroup>
-[[gnu::always_inline]] inline void for_each_group(const StepArrays& s, const PrefetchPlan& plan, const ContactModel& m,
-                                                  std::uint32_t begin, std::uint32_t end, PerGroup per_group) {
-  const GroupLists lists = std::get<GroupLists>(s.lists);
-  const bool led = plan.lead_begin < plan.lead_end;
-  const std::uint32_t lead_begin = led ? plan.lead_begin : begin, lead_end = led ? plan.lead_end : begin;
+[[gnu::always_inline]] inline void for_each_group(const StepContext& ctx, const EdgeFetches& edges, std::uint32_t begin,
+                                                  std::uint32_t end, PerGroup per_group) {
+  const GroupLists lists = std::get<GroupLists>(ctx.arrays.lists);
+  const bool led = edges.lead_begin < edges.lead_end;
+  const std::uint32_t lead_begin = led ? edges.lead_begin : begin, lead_end = led ? edges.lead_end : begin;
   const std::uint32_t from[3] = {lead_begin, begin, lead_end}, to[3] = {lead_end, lead_begin, end};
   for (int part = 0; part < 3; ++part)
     for (std::uint32_t batch = from[part]; batch < to[part]; batch += kStepBatch)
-      for_each_group_of_batch<V>(s, lists, plan, m, batch, end, per_group);
+      for_each_group_of_batch<V>(ctx, lists, edges, batch, end, per_group);
 }
 
 template <class V>
-Moved step(const StepArrays& arrays, const PrefetchPlan& prefetch_plan, const ContactModel& model, std::uint32_t begin,
-           std::uint32_t end) {
+Moved step(const StepContext& context, std::uint32_t begin, std::uint32_t end) {
   // Local copies: stores through the output pointers cannot change them, so
-  // pointers and constants stay in registers.
-  const StepArrays s = arrays;
-  const PrefetchPlan plan = prefetch_plan;
-  const ContactModel m = model;
+  // pointers and constants stay in registers. The call takes the caller's
+  // plan: a local whose address escaped would be reloaded after every store.
+  const EdgeFetches edges = edge_fetches(context.plan, begin, end);
+  const StepContext ctx = context;
+  const StepArrays& s = ctx.arrays;
+  const ContactModel& m = ctx.model;
   V max_d2 = V::zero(), max_v2 = V::zero();
   const V stray_d2 = V::splat(s.stray_d2);
   std::uint32_t* const stray_balls = s.stray_balls + begin;
   std::uint32_t strayed = 0;
   for_each_group<V>(
-      s, plan, m, begin, end,
+      ctx, edges, begin, end,
       [&](const std::uint32_t* at, const GroupBalls<V>& i, V ax, V ay, V az, const std::uint32_t* record) {
         const V half_dt = V::splat(m.half_dt), dt = V::splat(m.dt);
         const V vx = mul_add(ax, half_dt, i.vx), vy = mul_add(ay, half_dt, i.vy), vz = mul_add(az, half_dt, i.vz);
@@ -445,8 +450,8 @@ Moved step(const StepArrays& arrays, const PrefetchPlan& prefetch_plan, const Co
 }
 
 template <class V>
-void accelerations(const StepArrays& s, const ContactModel& m, Float4* acc, std::uint32_t begin, std::uint32_t end) {
-  for_each_group<V>(s, PrefetchPlan{}, m, begin, end,
+void accelerations(const StepContext& ctx, Float4* acc, std::uint32_t begin, std::uint32_t end) {
+  for_each_group<V>(ctx, EdgeFetches{}, begin, end,
                     [&](const std::uint32_t* at, const GroupBalls<V>&, V ax, V ay, V az, const std::uint32_t*) {
                       Lanes<V>::store(ax, ay, az, V::zero(), acc, at);
                     });

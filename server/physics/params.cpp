@@ -81,7 +81,6 @@ ContactModel make_contact_model(const PhysicsParams& p) {
   m.half_dt = 0.5f * m.dt;
   m.damping_boost = 0.25f * m.damping_factor * m.damping_factor * m.dt;
   m.gravity = p.gravity;
-  m.tank = p.tank;
   return m;
 }
 

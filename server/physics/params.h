@@ -52,7 +52,6 @@ struct ContactModel {
   float dt;
   float half_dt;
   float gravity;
-  TankBounds tank;
   // No pair's overlap moves further than this in half a step: the fastest
   // ball's and the faster of that and a player's speed, times dt / 2. Pairs
   // further apart neither touch nor start to; the World sets it each step.

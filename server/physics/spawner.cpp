@@ -9,7 +9,7 @@ namespace {
 constexpr float kClearance = 0.01f;  // gap kept between a new ball and anything else
 }
 
-Spawner::Spawner(const TankBounds& tank, std::uint64_t seed) : tank_(tank), rng_(seed) {
+Spawner::Spawner(const TankBounds& tank, std::uint64_t seed) : rng_(seed) {
   Vec3 size = tank.size();
   slots_x_ = std::max(1, static_cast<int>(size.x / kMaxBallDiameter));
   slots_z_ = std::max(1, static_cast<int>(size.z / kMaxBallDiameter));
@@ -28,13 +28,13 @@ void Spawner::enqueue(std::uint32_t count) {
   }
 }
 
-void Spawner::place(const Float4* pos, std::uint32_t n, const Float4* players, int player_count,
+void Spawner::place(const TankBounds& tank, const Float4* pos, std::uint32_t n, const Float4* players, int player_count,
                     std::vector<NewBall>& placed) {
   if (queue_.empty()) return;
-  const float entry_floor = tank_.max.y - kMaxBallDiameter - kClearance;
+  const float entry_floor = tank.max.y - kMaxBallDiameter - kClearance;
   auto slot_of = [&](float x, float z) {
-    int sx = std::clamp(static_cast<int>((x - tank_.min.x) / slot_edge_x_), 0, slots_x_ - 1);
-    int sz = std::clamp(static_cast<int>((z - tank_.min.z) / slot_edge_z_), 0, slots_z_ - 1);
+    int sx = std::clamp(static_cast<int>((x - tank.min.x) / slot_edge_x_), 0, slots_x_ - 1);
+    int sz = std::clamp(static_cast<int>((z - tank.min.z) / slot_edge_z_), 0, slots_z_ - 1);
     return sx + slots_x_ * sz;
   };
 
@@ -74,9 +74,9 @@ void Spawner::place(const Float4* pos, std::uint32_t n, const Float4* players, i
     const float slack_x = std::max(0.0f, 0.5f * slot_edge_x_ - r - kClearance);
     const float slack_z = std::max(0.0f, 0.5f * slot_edge_z_ - r - kClearance);
     const int sx = static_cast<int>(slot) % slots_x_, sz = static_cast<int>(slot) / slots_x_;
-    Float4 candidate{tank_.min.x + (sx + 0.5f) * slot_edge_x_ + slack_x * (2.0f * uniform() - 1.0f),
-                     tank_.max.y - r - kClearance,
-                     tank_.min.z + (sz + 0.5f) * slot_edge_z_ + slack_z * (2.0f * uniform() - 1.0f), r};
+    Float4 candidate{tank.min.x + (sx + 0.5f) * slot_edge_x_ + slack_x * (2.0f * uniform() - 1.0f),
+                     tank.max.y - r - kClearance,
+                     tank.min.z + (sz + 0.5f) * slot_edge_z_ + slack_z * (2.0f * uniform() - 1.0f), r};
     if (!is_free(candidate, static_cast<int>(slot))) continue;
     placed.push_back({queue_.front(), candidate, Float4{0.0f, -kEntrySpeed, 0.0f, kind.mass}});
     queue_.pop_front();

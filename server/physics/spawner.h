@@ -25,6 +25,7 @@ struct NewBall {
 
 class Spawner {
  public:
+  // The slots' lattice fits the tank given here, the one place() is then given.
   Spawner(const TankBounds& tank, std::uint64_t seed);
 
   // Queues count balls; kinds take turns so every kind gets an equal share.
@@ -32,14 +33,14 @@ class Spawner {
   std::uint32_t pending() const { return static_cast<std::uint32_t>(queue_.size()); }
 
   // Moves as many queued balls as fit into `placed`.
-  void place(const Float4* pos, std::uint32_t n, const Float4* players, int player_count, std::vector<NewBall>& placed);
+  void place(const TankBounds& tank, const Float4* pos, std::uint32_t n, const Float4* players, int player_count,
+             std::vector<NewBall>& placed);
 
   static constexpr float kEntrySpeed = 3.0f;  // m/s downward, so a layer clears quickly
 
  private:
   float uniform();  // [0, 1), the same on every platform
 
-  TankBounds tank_;
   std::mt19937_64 rng_;
   std::deque<int> queue_;
   int next_kind_ = 0;

@@ -1,8 +1,13 @@
 #pragma once
 // The simulated world: ball state, the spawn queue, player spheres, and the
-// fixed-dt step. Only the thread that owns a World touches it.
+// fixed-dt step. Only the thread that owns a World touches it. One concept per file:
+//   world.cpp           state and admission: balls queued, placed, spawned; restart
+//   world_players.cpp   the kinematic player spheres
+//   world_step.cpp      the step and its list policy (below)
+//   prefetch_plan.h     what the SIMD step asks memory for ahead
+//   world_measures.h    what observers measure: energies, overlaps, contacts, the state hash
 //
-// One step (server/physics/world.cpp, step()):
+// One step (world_step.cpp, World::step()):
 //
 //   spawn round (every kSpawnInterval steps while balls are queued)
 //   swap           the last pass's pos_next, vel_half_next become pos, vel_half
@@ -19,7 +24,7 @@
 
 #include <chrono>
 #include <cstdint>
-#include <optional>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -27,10 +32,8 @@
 #include "common/tank.h"
 #include "server/physics/broadphase.h"
 #include "server/physics/kernels.h"
-#include "server/physics/machine_load.h"
 #include "server/physics/params.h"
 #include "server/physics/spawner.h"
-#include "server/physics/thread_tuner.h"
 #include "server/physics/worker_pool.h"
 
 namespace fishtank {
@@ -43,6 +46,17 @@ struct PhaseSeconds {
   double sort = 0.0;
   double list_build = 0.0;
   double stray_checks = 0.0;
+};
+
+// Adds the seconds of its scope to a phase's total.
+class PhaseTimer {
+ public:
+  explicit PhaseTimer(double& total) : total_(total), start_(std::chrono::steady_clock::now()) {}
+  ~PhaseTimer() { total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+
+ private:
+  double& total_;
+  std::chrono::steady_clock::time_point start_;
 };
 
 struct AddResult {
@@ -112,22 +126,19 @@ class World {
   int threads() const { return pool_.threads(); }
   // The CPUs this process could use when the world was made; its pool pins its threads to them.
   const std::vector<int>& cpus() const { return pool_.cpus(); }
-  // Steps use at most this many of the threads (results do not depend on it).
+  // Steps use at most this many of the threads (results do not depend on it; the paced loop's TunedStepper
+  // chooses it).
   void set_thread_limit(int limit) { pool_.set_active_limit(limit); }
-  // Lets each step choose between every thread and one as the machine's load changes (ThreadTuner).
-  void set_thread_tuning(bool on);
-  // The threads the steps use: the tuner's choice between its probes.
-  int stepping_threads() const;
-  // While tuning: the cores work in other sessions keeps busy (MachineLoad::crowding), below 0 until measured.
-  double crowding_cores() const { return tuner_ && machine_load_.measured() ? machine_load_.crowding() : -1.0; }
-  std::uint64_t steps_on_one_thread() const { return one_thread_steps_; }
+  int thread_limit() const { return pool_.active_limit(); }
   // Each thread's fraction of the items of every pass since reset_thread_shares().
   std::vector<double> thread_shares() const { return pool_.shares(); }
   void reset_thread_shares() { pool_.reset_shares(); }
   // For tests: runs on a worker thread as it picks up each pass (WorkerPool::set_worker_hook).
   void set_worker_hook(std::function<void(int thread)> hook) { pool_.set_worker_hook(std::move(hook)); }
   const PhaseSeconds& phase_seconds() const { return phase_seconds_; }
-  double mean_neighbours() const;
+  // Whether the lists hold the balls now present: false before the first step and from a spawn or a
+  // placement to the next step.
+  bool lists_current() const { return !needs_rebuild_; }
 
   // Current (sorted) order; index with i < ball_count().
   const Float4* positions() const { return pos_.data(); }
@@ -137,27 +148,9 @@ class World {
   // The ball with permanent number id (linear search: for tests and tools).
   BallView ball(std::uint32_t id) const;
 
-  double kinetic_energy() const;
-  float max_speed() const;          // the fastest ball's, m/s
-  double potential_energy() const;  // gravity, relative to y = 0
-  double elastic_energy() const;    // springs of every contact: sum of k x^2 / 2
-  // Overlapping ball pairs and ball-wall contacts (0 before the first step).
-  std::uint32_t contact_count() const;
   // Kinetic plus gravitational energy of every ball at the moment it appeared:
   // with no player moving, the world's total energy can never exceed it.
   double energy_added() const { return energy_added_; }
-  // Largest overlap (ball-ball, ball-wall), as a fraction of the smaller radius.
-  float max_overlap_fraction() const;
-  // Whether max_overlap_fraction() is past kOverlapWarning while the balls are
-  // near rest, and a sentence that says so (empty otherwise): a softer k than
-  // the scene's load allows. An impact's overlap (v sqrt(m / k): 35 % at 28 m/s)
-  // passes, and max_overlap_fraction() still reports it.
-  std::string overlap_warning() const;
-  float pile_top() const;  // highest point of any ball
-  // Balls whose centre is outside the tank or whose state is not finite.
-  std::uint32_t escaped_or_invalid() const;
-  // FNV-1a over positions and velocities in id order: equal iff bit-identical.
-  std::uint64_t state_hash() const;
 
   static constexpr int kSpawnInterval = 20;
 
@@ -179,24 +172,19 @@ class World {
   void move_players();
   void resize(std::uint32_t n);
   void set_ghost();
-  StepArrays arrays();
+  // The arrays and the contact model of the next pass; no prefetch plan.
+  StepContext context();
   // Whether the SIMD step asks for rows ahead (PrefetchPlan): from kBeyondCacheBalls balls.
   bool beyond_cache() const { return n_ >= kBeyondCacheBalls; }
   // Tunable: about where the step's arrays (some 140 bytes a ball) outgrow second-level caches; below
   // it, asking ahead costs instructions and buys nothing.
   static constexpr std::uint32_t kBeyondCacheBalls = 32768;
   void derive_velocities() const;
-  void advance();  // one step, untimed
-  PrefetchPlan prefetch_plan() const;
-  void add_edge_fetches(PrefetchPlan& plan, std::uint32_t begin, std::uint32_t end) const;
 
   PhysicsParams params_;
   ContactModel model_;
   const Kernels& kernels_;
   WorkerPool pool_;
-  std::optional<ThreadTuner> tuner_;
-  MachineLoad machine_load_;
-  std::chrono::steady_clock::time_point tuner_epoch_;
   Spawner spawner_;
   NeighbourList list_;
 
@@ -231,8 +219,6 @@ class World {
   static constexpr std::uint32_t kStrayedBallsPerCheck = 256;
   // A check costs a few dozen balls' steps: a thread takes at least this many.
   static constexpr std::uint32_t kStrayChecksPerThread = 4;
-  // Kinetic energy per ball below which an overlap is a resting one (J): a unit ball at 0.1 m/s.
-  static constexpr double kRestingEnergyPerBall = 5e-3;
   static constexpr float kStrayMargin = 1.0f - 1e-5f;  // a ball right at skin / 2 counts as strayed
   // What each chunk of the last step pass reported.
   struct ChunkMoved {
@@ -249,7 +235,6 @@ class World {
   double time_ = 0.0;
   double energy_added_ = 0.0;
   std::uint64_t steps_ = 0;
-  std::uint64_t one_thread_steps_ = 0;
   std::uint64_t rebuilds_ = 0;
   std::uint64_t lists_kept_by_checks_ = 0;
   std::uint64_t strayed_checked_ = 0;

@@ -13,6 +13,8 @@
 #include <thread>
 #include <vector>
 
+#include "server/physics/prefetch_plan.h"
+#include "server/physics/world_measures.h"
 #include "tests/physics/scenarios.h"
 
 using namespace fishtank;
@@ -41,8 +43,8 @@ std::uint64_t run(const Kernels& kernels, int threads, std::function<void(int)> 
     world.step();
   }
   REQUIRE(world.threads() == threads);
-  REQUIRE(world.escaped_or_invalid() == 0);
-  return world.state_hash();
+  REQUIRE(escaped_or_invalid(world) == 0);
+  return state_hash(world);
 }
 
 }  // namespace
@@ -122,9 +124,9 @@ WideRun run_wide(int threads) {
     world.place_ball(b % kKindCount, p, Vec3{0.5f * (b % 7) - 1.5f, 0.0f, 0.5f * (b % 5) - 1.0f});
   }
   for (int s = 0; s < 200; ++s) world.step();
-  REQUIRE(world.escaped_or_invalid() == 0);
+  REQUIRE(escaped_or_invalid(world) == 0);
   REQUIRE(world.rebuilds() > 1);
-  WideRun out{world.state_hash(), 0};
+  WideRun out{state_hash(world), 0};
   for (std::uint32_t b = 0; b < (world.ball_count() + kStepBatch - 1) / kStepBatch; ++b)
     out.remote_lines += world.neighbour_list().remote_rows()[b].count;
   return out;
@@ -146,6 +148,7 @@ namespace {
 // order, with their lists as a kernel set builds them.
 struct DenseScene {
   ContactModel model;
+  TankBounds tank;
   AlignedVector<Float4> pos, vel_half;
   NeighbourList list;
   std::uint32_t n;
@@ -155,6 +158,7 @@ struct DenseScene {
     params.tank.min = {-6.0f, 0.0f, -6.0f};
     params.tank.max = {6.0f, 12.0f, 6.0f};
     model = make_contact_model(params);
+    tank = params.tank;
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> at(-5.0f, 5.0f), speed(-1.0f, 1.0f);
     AlignedVector<Float4> unsorted(n + kGhostSlots, kGhostPos), unsorted_vel(n + kGhostSlots, Float4{0, 0, 0, 1});
@@ -180,14 +184,17 @@ struct DenseScene {
   std::vector<std::uint32_t> step_bits(const Kernels& kernels, const std::vector<std::uint32_t>& bounds,
                                        const GroupLists& layout) const {
     AlignedVector<Float4> pos_next(n), vel_half_next(n);
-    StepArrays s;
+    StepContext ctx;
+    StepArrays& s = ctx.arrays;
     s.pos = pos.data();
     s.vel_half = vel_half.data();
     s.pos_next = pos_next.data();
     s.vel_half_next = vel_half_next.data();
     s.lists = layout;
-    for (std::size_t r = 0; r + 1 < bounds.size(); ++r)
-      kernels.step(s, PrefetchPlan{}, model, bounds[r], bounds[r + 1]);
+    s.tank = tank;
+    ctx.plan = prefetch_plan(list, n, false);  // each range asks for its edge rows, as a world's chunks do
+    ctx.model = model;
+    for (std::size_t r = 0; r + 1 < bounds.size(); ++r) kernels.step(ctx, bounds[r], bounds[r + 1]);
     std::vector<std::uint32_t> bits;
     for (const AlignedVector<Float4>* out : {&pos_next, &vel_half_next})
       for (const Float4& f : *out)

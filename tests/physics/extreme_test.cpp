@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "server/physics/world_measures.h"
 #include "tests/physics/scenarios.h"
 
 using namespace fishtank;
@@ -13,7 +14,7 @@ using namespace fishtank::test;
 
 namespace {
 
-double total_energy(const World& w) { return w.kinetic_energy() + w.potential_energy() + w.elastic_energy(); }
+double total_energy(const World& w) { return kinetic_energy(w) + potential_energy(w) + elastic_energy(w); }
 
 }  // namespace
 
@@ -31,11 +32,11 @@ TEST_CASE("asking for three tanks' worth of balls fills one, refuses the rest, a
   // Whatever could not pour in yet waits at the top; nothing is lost.
   for (int s = 0; s < static_cast<int>(40.0 / world.dt()) && world.pending() > 0; ++s) world.step();
   INFO("in the tank " << world.ball_count() << ", still queued " << world.pending() << ", pile top "
-                      << world.pile_top());
+                      << pile_top(world));
   CHECK(world.ball_count() + world.pending() == world.capacity());
-  CHECK(world.escaped_or_invalid() == 0);
-  CHECK(world.pile_top() <= world.params().tank.max.y + 0.01f);
-  CHECK(world.max_overlap_fraction() < 0.15f);
+  CHECK(escaped_or_invalid(world) == 0);
+  CHECK(pile_top(world) <= world.params().tank.max.y + 0.01f);
+  CHECK(max_overlap_fraction(world) < 0.15f);
 }
 
 TEST_CASE("a full tank soaked for 120 simulated seconds keeps every ball and never gains energy",
@@ -47,7 +48,7 @@ TEST_CASE("a full tank soaked for 120 simulated seconds keeps every ball and nev
   for (int s = 1; s <= steps; ++s) {
     world.step();
     if (s % 1000 != 0) continue;
-    REQUIRE(world.escaped_or_invalid() == 0);
+    REQUIRE(escaped_or_invalid(world) == 0);
     const double energy = total_energy(world);
     REQUIRE(std::isfinite(energy));
     worst_ratio = std::max(worst_ratio, energy / world.energy_added());
@@ -61,7 +62,7 @@ TEST_CASE("a full tank soaked for 120 simulated seconds keeps every ball and nev
   // energy has been dissipated. An energy blow-up would be orders above this.
   CHECK(worst_ratio < 1.001);
   // At the end the pile is at rest: what is left is potential and spring energy.
-  CHECK(world.kinetic_energy() / world.ball_count() < 1e-3);
+  CHECK(kinetic_energy(world) / world.ball_count() < 1e-3);
 }
 
 TEST_CASE("balls added to a full, settled tank wait at the top instead of being forced in", "[physics][extreme]") {
@@ -73,8 +74,8 @@ TEST_CASE("balls added to a full, settled tank wait at the top instead of being 
   CHECK_FALSE(more.refusal.empty());
   for (int s = 0; s < static_cast<int>(10.0 / world.dt()); ++s) world.step();
   CHECK(world.ball_count() + world.pending() == world.capacity());
-  CHECK(world.escaped_or_invalid() == 0);
-  CHECK(world.max_overlap_fraction() < 0.15f);
+  CHECK(escaped_or_invalid(world) == 0);
+  CHECK(max_overlap_fraction(world) < 0.15f);
 }
 
 TEST_CASE("a player velocity too large to square in a float is clamped to the top speed, not stopped",

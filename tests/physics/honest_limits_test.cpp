@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 
+#include "server/physics/world_measures.h"
 #include "tests/physics/scenarios.h"
 
 using namespace fishtank;
@@ -30,9 +31,9 @@ TEST_CASE("a resting overlap beyond 10 % of the smaller radius gives a warning, 
   World world(params, kScalarKernels, 1, 1);
   world.place_ball(0, {0.0f, 0.5f, 0.0f}, {});
   while (world.time() < 30.0) world.step();  // a few hundred contact durations: damped to rest
-  const std::string warning = world.overlap_warning();
-  INFO("sink " << sink << ": overlap " << world.max_overlap_fraction() << ", " << warning);
-  CHECK(world.max_overlap_fraction() == Approx(sink / 0.5f).epsilon(0.02));
+  const std::string warning = overlap_warning(world);
+  INFO("sink " << sink << ": overlap " << max_overlap_fraction(world) << ", " << warning);
+  CHECK(max_overlap_fraction(world) == Approx(sink / 0.5f).epsilon(0.02));
   CHECK(warning.empty() == (sink / 0.5f <= kOverlapWarning));
 }
 
@@ -45,8 +46,8 @@ TEST_CASE("an impact's deep overlap is reported but gives no warning", "[physics
   float deepest = 0.0f;
   for (int s = 0; s < 40; ++s) {
     world.step();
-    deepest = std::max(deepest, world.max_overlap_fraction());
-    CHECK(world.overlap_warning().empty());
+    deepest = std::max(deepest, max_overlap_fraction(world));
+    CHECK(overlap_warning(world).empty());
   }
   CHECK(deepest > 0.25f);
 }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "server/physics/world.h"
+#include "server/physics/world_measures.h"
 
 namespace fishtank::test {
 
@@ -47,7 +48,7 @@ inline void pour_and_settle(World& world, std::uint32_t balls, double max_second
   const int check_every = static_cast<int>(0.1 / world.dt());
   for (double t = 0.0; t < max_seconds; t += world.dt()) {
     world.step();
-    if (world.steps() % check_every == 0 && world.pending() == 0 && world.kinetic_energy() / world.ball_count() < 1e-3)
+    if (world.steps() % check_every == 0 && world.pending() == 0 && kinetic_energy(world) / world.ball_count() < 1e-3)
       return;
   }
 }

@@ -8,6 +8,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "server/physics/world_measures.h"
 #include "tests/physics/scenarios.h"
 
 using namespace fishtank;
@@ -26,7 +27,7 @@ namespace {
 float short_horizon_difference(const Kernels& kernels) {
   World pile(PhysicsParams{}, kSseKernels, 2, 1);
   pour_and_settle(pile, 1001, 40.0);
-  REQUIRE(pile.mean_neighbours() > 5.0);
+  REQUIRE(mean_neighbours(pile) > 5.0);
   World scalar(PhysicsParams{}, kScalarKernels, 1, 1);
   World simd(PhysicsParams{}, kernels, 2, 1);
   for (World* w : {&scalar, &simd}) {
@@ -73,8 +74,8 @@ TEST_CASE("scalar and SSE settle into the same pile", "[physics][variants][slow]
       double sum = 0.0;
       for (std::uint32_t i = 0; i < world.ball_count(); ++i) sum += world.positions()[i].y;
       average.mean_height += sum / world.ball_count() / kPours;
-      average.top += world.pile_top() / kPours;
-      average.overlap += world.max_overlap_fraction() / kPours;
+      average.top += pile_top(world) / kPours;
+      average.overlap += max_overlap_fraction(world) / kPours;
     }
     return average;
   };

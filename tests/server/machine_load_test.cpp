@@ -2,7 +2,7 @@
 // counters less this process's CPU time, and says whether every thread would
 // find a core of its own.
 
-#include "server/physics/machine_load.h"
+#include "server/machine_load.h"
 
 #include <catch2/catch.hpp>
 #include <string>

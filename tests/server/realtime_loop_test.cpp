@@ -37,7 +37,8 @@ Observed run_paced(World& world, double seconds, RunControl* control = nullptr) 
   const double sim_before = world.time();
   const auto start = std::chrono::steady_clock::now();
   const std::atomic<bool> stop{false};
-  run_realtime(world, options, stop);
+  TunedStepper stepper(world, false);
+  run_realtime(stepper, options, stop);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   seen.boundaries_per_s = boundaries / wall;
   seen.sim_seconds = world.time() - sim_before;

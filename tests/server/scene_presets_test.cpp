@@ -9,6 +9,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "server/physics/world_measures.h"
 #include "server/scenes/active_scene.h"
 
 using namespace fishtank;
@@ -53,7 +54,7 @@ TEST_CASE("every placed preset holds exactly its balls, inside its tank, none to
     World world = world_for(spec);
     REQUIRE(populate(world, spec).empty());
     CHECK(world.ball_count() == spec.balls);
-    CHECK(world.escaped_or_invalid() == 0);
+    CHECK(escaped_or_invalid(world) == 0);
     CHECK(closest_gap(world) > 0.0f);
   }
   const SceneSpec tank = preset("tank");
@@ -77,7 +78,7 @@ TEST_CASE("the dam-break column stands against the -x wall and spreads across th
   run_steps(world, static_cast<int>(2.0 / world.dt()));
   INFO("front from x = " << start << " to " << front());
   CHECK(front() > start + 10.0f);  // a 17-unit column falling over reaches well beyond its width
-  CHECK(world.escaped_or_invalid() == 0);
+  CHECK(escaped_or_invalid(world) == 0);
 }
 
 TEST_CASE("the drop scene's large balls all start above its bed of small ones", "[scenes]") {
@@ -107,14 +108,14 @@ TEST_CASE("a restart with the same seed reproduces the run bit for bit, another 
     World world(params, kSseKernels, 1, 1);
     REQUIRE(scene.start(world).empty());
     run_steps(world, 400);
-    const std::uint64_t first = world.state_hash();
+    const std::uint64_t first = state_hash(world);
     REQUIRE(scene.start(world).empty());  // the same scene, the same seed
     CHECK(world.ball_count() <= 300);
     run_steps(world, 400);
-    CHECK(world.state_hash() == first);
+    CHECK(state_hash(world) == first);
     REQUIRE(scene.start(world, std::nullopt, 2).empty());
     run_steps(world, 400);
-    CHECK(world.state_hash() != first);
+    CHECK(state_hash(world) != first);
     CHECK(scene.seed() == 2);
     CHECK(scene.start_count() == 3);
   }
@@ -145,7 +146,7 @@ TEST_CASE("switching scene changes the tank, restarts ball ids at 0 and keeps ev
   const Vec3 apart = world.player_position(a) - world.player_position(b);
   CHECK(std::sqrt(dot(apart, apart)) >= kPlayerDiameter);
   run_steps(world, 500);
-  CHECK(world.escaped_or_invalid() == 0);
+  CHECK(escaped_or_invalid(world) == 0);
 }
 
 TEST_CASE("a scene whose tank holds fewer balls than --max-balls says so, and its capacity is the limit", "[scenes]") {

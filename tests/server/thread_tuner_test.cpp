@@ -2,7 +2,7 @@
 // running estimates find cheaper, and follows a change of load within about
 // half a second.
 
-#include "server/physics/thread_tuner.h"
+#include "server/thread_tuner.h"
 
 #include <catch2/catch.hpp>
 

@@ -1,4 +1,4 @@
-#include "server/physics/machine_load.h"
+#include "server/machine_load.h"
 
 #include <dirent.h>
 #include <fcntl.h>

@@ -1,4 +1,4 @@
-#include "server/physics/thread_tuner.h"
+#include "server/thread_tuner.h"
 
 #include <algorithm>
 #include <cmath>
