@@ -252,11 +252,19 @@ template <class V>
 }
 
 // One axis of the six half-space walls: below the minimum face the force
-// points +axis, above the maximum face -axis; both grow with depth.
+// points +axis, above the maximum face -axis; both grow with depth. A ball
+// reaches one face of an axis at most, so the law runs once, on the nearer
+// face (the other's force is zero); where no lane's contact starts or ends
+// there, it is k x - damping v_n with the group's damping (contact_law.h).
 template <class V>
-[[gnu::always_inline]] inline V wall_force(const ContactModel& m, V c, V inv_m, V p, V v, V r, float lo, float hi) {
-  return normal_force(m, V::splat(lo) + r - p, v, c, inv_m) -
-         normal_force(m, p + r - V::splat(hi), V::zero() - v, c, inv_m);
+[[gnu::always_inline]] inline V wall_force(const ContactModel& m, V c, V damping, V inv_m, V p, V v, V r, float lo,
+                                           float hi) {
+  const V below = V::splat(lo) + r - p, above = p + r - V::splat(hi);
+  const auto lower = below > above;
+  const V overlap = select(lower, below, above), v_n = select(lower, v, V::zero() - v);
+  const V f = simd::any(starting_or_ending(m, overlap, v_n)) ? normal_force(m, overlap, v_n, c, inv_m)
+                                                             : whole_or_no_contact_force(m, overlap, v_n, damping);
+  return select(lower, f, V::zero() - f);
 }
 
 // a = F / m + g for a group's balls: their neighbours' forces f, plus player
@@ -266,10 +274,10 @@ template <class V>
                                                 V& fx, V& fy, V& fz) {
   const TankBounds& t = m.tank;
   const V r = i.r, reach = r + V::splat(m.lead_bound);
-  const auto near_wall = (V::splat(t.min.x) + reach > i.x) | (i.x + reach > V::splat(t.max.x)) |
-                         (V::splat(t.min.y) + reach > i.y) | (i.y + reach > V::splat(t.max.y)) |
-                         (V::splat(t.min.z) + reach > i.z) | (i.z + reach > V::splat(t.max.z));
-  const bool walls = simd::any(near_wall);  // most groups touch no wall
+  const auto near_x = (V::splat(t.min.x) + reach > i.x) | (i.x + reach > V::splat(t.max.x));
+  const auto near_y = (V::splat(t.min.y) + reach > i.y) | (i.y + reach > V::splat(t.max.y));
+  const auto near_z = (V::splat(t.min.z) + reach > i.z) | (i.z + reach > V::splat(t.max.z));
+  const bool walls = simd::any(near_x | near_y | near_z);  // most groups touch no wall
   if (walls || s.players > 0) {
     const V c = contact_damping(m, i.inv_m);  // walls and players are kinematic: m_eff = m
     for (int p = 0; p < s.players; ++p) {
@@ -288,10 +296,11 @@ template <class V>
       fy = neg_mul_add(f_over_dist, dy, fy);
       fz = neg_mul_add(f_over_dist, dz, fz);
     }
-    if (walls) {
-      fx += wall_force(m, c, i.inv_m, i.x, i.vx, r, t.min.x, t.max.x);
-      fy += wall_force(m, c, i.inv_m, i.y, i.vy, r, t.min.y, t.max.y);
-      fz += wall_force(m, c, i.inv_m, i.z, i.vz, r, t.min.z, t.max.z);
+    if (walls) {  // an axis no lane is near adds zero
+      const V damping = whole_step_damping(m, c, i.inv_m);
+      if (simd::any(near_x)) fx += wall_force(m, c, damping, i.inv_m, i.x, i.vx, r, t.min.x, t.max.x);
+      if (simd::any(near_y)) fy += wall_force(m, c, damping, i.inv_m, i.y, i.vy, r, t.min.y, t.max.y);
+      if (simd::any(near_z)) fz += wall_force(m, c, damping, i.inv_m, i.z, i.vz, r, t.min.z, t.max.z);
     }
   }
   fx = fx * i.inv_m;
