@@ -235,7 +235,8 @@ template <class V>
     const V overlap = reach - d2 * inv_dist;
     const V v_n = mul_add(dvz, dz, mul_add(dvy, dy, dvx * dx)) * inv_dist;
     V f;
-    if (simd::any(near & starting_or_ending(m, overlap, v_n))) [[unlikely]] {
+    // Lanes that are not near cannot start within the step (lead_bound bounds every lead): not masked.
+    if (simd::any(starting_or_ending(m, overlap, v_n))) [[unlikely]] {
       V c = kind_c[0];
       for (int k = 1; k < kKindCount; ++k) c = select(inv_mj == kind_inv_m[k], kind_c[k], c);
       f = keep(near, normal_force(m, overlap, v_n, c, i.inv_m + inv_mj));
