@@ -189,12 +189,44 @@ std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t
 template <class V>
 struct Lanes;
 
+// c and c / (1 + beta) (contact_law.h) of each pair of ball kinds, and of each
+// kind against a wall or a player (kinematic: m_eff = m). Made once per batch
+// with the scalar law, the same values each lane would compute: a group then
+// picks its lanes' rows instead of taking square roots and quotients.
+struct KindDamping {
+  float c[kKindCount][kKindCount], damping[kKindCount][kKindCount];  // [kind of i][kind of j]
+  float kinematic_c[kKindCount], kinematic_damping[kKindCount];
+
+  explicit KindDamping(const ContactModel& m) {
+    for (int a = 0; a < kKindCount; ++a) {
+      const float inv_m = 1.0f / kBallKinds[a].mass;
+      kinematic_c[a] = contact_damping(m, inv_m);
+      kinematic_damping[a] = whole_step_damping(m, kinematic_c[a], inv_m);
+      for (int b = 0; b < kKindCount; ++b) {
+        const float inv_m_sum = inv_m + 1.0f / kBallKinds[b].mass;
+        c[a][b] = contact_damping(m, inv_m_sum);
+        damping[a][b] = whole_step_damping(m, c[a][b], inv_m_sum);
+      }
+    }
+  }
+};
+
+// Each lane's entry of a per-kind row; a ball's kind is known by its 1 / mass.
+template <class V>
+[[gnu::always_inline]] inline V of_lane_kinds(V inv_m, const float (&of_kind)[kKindCount]) {
+  V value = V::splat(of_kind[0]);
+  for (int k = 1; k < kKindCount; ++k)
+    value = select(inv_m == V::splat(1.0f / kBallKinds[k].mass), V::splat(of_kind[k]), value);
+  return value;
+}
+
 // A group's balls, one per lane.
 template <class V>
 struct GroupBalls {
   V x, y, z, r;  // position, radius
   V vx, vy, vz;  // half-step velocity
   V inv_m;       // 1 / mass
+  const KindDamping* kinds;
 };
 
 // Sum over each lane's neighbours of the contact force, into fx, fy, fz, in
@@ -207,13 +239,14 @@ template <class V>
 [[gnu::always_inline]] inline void neighbour_forces(const StepArrays& s, const ContactModel& m,
                                                     const std::uint32_t* block, std::uint32_t blocks,
                                                     const GroupBalls<V>& i, V& fx, V& fy, V& fz) {
-  // A neighbour's kind is known by its 1 / mass: c and c / (1 + beta) of each pair, once per group.
+  // A neighbour's kind is known by its 1 / mass: c and c / (1 + beta) of each lane's pair with each kind.
   V kind_inv_m[kKindCount], kind_c[kKindCount], kind_damping[kKindCount];
   for (int k = 0; k < kKindCount; ++k) {
     kind_inv_m[k] = V::splat(1.0f / kBallKinds[k].mass);
-    const V inv_m_sum = i.inv_m + kind_inv_m[k];
-    kind_c[k] = contact_damping(m, inv_m_sum);
-    kind_damping[k] = whole_step_damping(m, kind_c[k], inv_m_sum);
+    float c[kKindCount], damping[kKindCount];
+    for (int a = 0; a < kKindCount; ++a) c[a] = i.kinds->c[a][k], damping[a] = i.kinds->damping[a][k];
+    kind_c[k] = of_lane_kinds(i.inv_m, c);
+    kind_damping[k] = of_lane_kinds(i.inv_m, damping);
   }
   const V lead_bound = V::splat(m.lead_bound);
   const V tiny = V::splat(1e-12f);  // squared distance floor: coincident centres stay finite
@@ -280,7 +313,7 @@ template <class V>
   const auto near_z = (V::splat(t.min.z) + reach > i.z) | (i.z + reach > V::splat(t.max.z));
   const bool walls = simd::any(near_x | near_y | near_z);  // most groups touch no wall
   if (walls || s.players > 0) {
-    const V c = contact_damping(m, i.inv_m);  // walls and players are kinematic: m_eff = m
+    const V c = of_lane_kinds(i.inv_m, i.kinds->kinematic_c);
     for (int p = 0; p < s.players; ++p) {
       const Float4 pj = s.player_pos[p], vj = s.player_vel[p];
       const V dx = V::splat(pj.x) - i.x, dy = V::splat(pj.y) - i.y, dz = V::splat(pj.z) - i.z;
@@ -298,7 +331,7 @@ template <class V>
       fz = neg_mul_add(f_over_dist, dz, fz);
     }
     if (walls) {  // an axis no lane is near adds zero
-      const V damping = whole_step_damping(m, c, i.inv_m);
+      const V damping = of_lane_kinds(i.inv_m, i.kinds->kinematic_damping);
       if (simd::any(near_x)) fx += wall_force(m, c, damping, i.inv_m, i.x, i.vx, r, t.min.x, t.max.x);
       if (simd::any(near_y)) fy += wall_force(m, c, damping, i.inv_m, i.y, i.vy, r, t.min.y, t.max.y);
       if (simd::any(near_z)) fz += wall_force(m, c, damping, i.inv_m, i.z, i.vz, r, t.min.z, t.max.z);
@@ -387,6 +420,7 @@ template <class V, class PerGroup>
   // Decided once per batch: most batches are in no fetch's window (all, on one thread).
   const std::uint32_t batch_number = batch / kStepBatch;
   const bool fetching = in_window(plan.edge_fetch[0], batch_number) || in_window(plan.edge_fetch[1], batch_number);
+  const KindDamping kinds(m);
   for (std::uint32_t share = 0; share < groups; ++share, record += 4 * kCount) {
     if (plan.beyond_cache) prefetch_batch_ahead<kCount>(s, lists, plan, batch, share);
     if (fetching)
@@ -394,6 +428,7 @@ template <class V, class PerGroup>
     const std::uint32_t blocks = group_blocks[share];
     const std::uint32_t* const at = record + 3 * kCount;  // the group's list entries
     GroupBalls<V> i;
+    i.kinds = &kinds;
     Lanes<V>::load(s.pos, at, i.x, i.y, i.z, i.r);
     Lanes<V>::load(s.vel_half, at, i.vx, i.vy, i.vz, i.inv_m);
     V ax, ay, az;
