@@ -243,10 +243,8 @@ template <class V>
   V kind_inv_m[kKindCount], kind_c[kKindCount], kind_damping[kKindCount];
   for (int k = 0; k < kKindCount; ++k) {
     kind_inv_m[k] = V::splat(1.0f / kBallKinds[k].mass);
-    float c[kKindCount], damping[kKindCount];
-    for (int a = 0; a < kKindCount; ++a) c[a] = i.kinds->c[a][k], damping[a] = i.kinds->damping[a][k];
-    kind_c[k] = of_lane_kinds(i.inv_m, c);
-    kind_damping[k] = of_lane_kinds(i.inv_m, damping);
+    kind_c[k] = of_lane_kinds(i.inv_m, i.kinds->c[k]);  // the tables are symmetric
+    kind_damping[k] = of_lane_kinds(i.inv_m, i.kinds->damping[k]);
   }
   const V lead_bound = V::splat(m.lead_bound);
   const V tiny = V::splat(1e-12f);  // squared distance floor: coincident centres stay finite
