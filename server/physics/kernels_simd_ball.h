@@ -229,25 +229,61 @@ struct GroupBalls {
   const KindDamping* kinds;
 };
 
-// Sum over each lane's neighbours of the contact force, into fx, fy, fz, in
-// list order as in the scalar twin. d points from ball i to its neighbour.
-// Most blocks hold contacts that last the whole step (or none): their law is
-// k x - damping v_n, with damping taken by the neighbour's kind from a table
-// made once per group; a block with a contact starting or ending takes the
-// whole law (contact_law.h). Both give the scalar twin's value to float rounding.
+// Below this lead bound (every ball nearly at rest), contacts that start or end are too rare to pay for
+// deferring them (neighbour_forces); in a moving pile they are common.
+constexpr float kStillLead = 1e-3f;
+
+// A block of a group's lists in which some lane's contact starts or ends.
+struct WholeLawBlock {
+  const std::uint32_t* block;
+  std::uint32_t share;  // the group's place in its batch
+};
+
+// Where a block's neighbours are and how they move, seen from the group's balls.
 template <class V>
+struct BlockPairs {
+  V dx, dy, dz;  // from ball i to its neighbour
+  V inv_dist, overlap, v_n;
+  V inv_mj;  // the neighbour's 1 / mass
+};
+
+template <class V>
+[[gnu::always_inline]] inline BlockPairs<V> block_pairs(const StepArrays& s, const std::uint32_t* block,
+                                                        const GroupBalls<V>& i, V dx, V dy, V dz, V d2, V reach) {
+  const V tiny = V::splat(1e-12f);  // squared distance floor: coincident centres stay finite
+  V dvx, dvy, dvz, inv_mj;
+  Lanes<V>::load(s.vel_half, block, dvx, dvy, dvz, inv_mj);
+  dvx -= i.vx, dvy -= i.vy, dvz -= i.vz;
+  const V inv_dist = simd::rsqrt(max(d2, tiny));
+  return {dx, dy, dz, inv_dist, reach - d2 * inv_dist, mul_add(dvz, dz, mul_add(dvy, dy, dvx * dx)) * inv_dist, inv_mj};
+}
+
+// c of each lane's pair with its neighbour of 1 / mass inv_mj.
+template <class V>
+[[gnu::always_inline]] inline V pair_c(const GroupBalls<V>& i, V inv_mj) {
+  V c = V::zero();
+  for (int k = 0; k < kKindCount; ++k)  // the tables are symmetric
+    c = select(inv_mj == V::splat(1.0f / kBallKinds[k].mass), of_lane_kinds(i.inv_m, i.kinds->c[k]), c);
+  return c;
+}
+
+// Sum over each lane's neighbours of the contact force, into fx, fy, fz, in
+// list order as in the scalar twin (deferred lanes after the rest). Most
+// contacts last the whole step (or are none): their law is k x - damping v_n,
+// with damping taken by the neighbour's kind from a table made once per group.
+// A lane whose contact starts or ends takes the whole law (contact_law.h): in
+// its block's turn (kDefer false), or later, in whole_law_forces, its block
+// listed at `deferred` (kDefer true): where a pile moves, a branch per block
+// on whether it holds one would be mispredicted often.
+template <bool kDefer, class V>
 [[gnu::always_inline]] inline void neighbour_forces(const StepArrays& s, const ContactModel& m,
                                                     const std::uint32_t* block, std::uint32_t blocks,
-                                                    const GroupBalls<V>& i, V& fx, V& fy, V& fz) {
-  // A neighbour's kind is known by its 1 / mass: c and c / (1 + beta) of each lane's pair with each kind.
-  V kind_inv_m[kKindCount], kind_c[kKindCount], kind_damping[kKindCount];
-  for (int k = 0; k < kKindCount; ++k) {
-    kind_inv_m[k] = V::splat(1.0f / kBallKinds[k].mass);
-    kind_c[k] = of_lane_kinds(i.inv_m, i.kinds->c[k]);  // the tables are symmetric
-    kind_damping[k] = of_lane_kinds(i.inv_m, i.kinds->damping[k]);
-  }
+                                                    const GroupBalls<V>& i, V& fx, V& fy, V& fz, std::uint32_t share,
+                                                    WholeLawBlock*& deferred) {
+  // A neighbour's kind is known by its 1 / mass: c / (1 + beta) of each lane's pair with each kind.
+  V kind_damping[kKindCount];
+  for (int k = 0; k < kKindCount; ++k) kind_damping[k] = of_lane_kinds(i.inv_m, i.kinds->damping[k]);
   const V lead_bound = V::splat(m.lead_bound);
-  const V tiny = V::splat(1e-12f);  // squared distance floor: coincident centres stay finite
   fx = fy = fz = V::zero();
   // Past its end, a shorter list's lane holds the ghost: it touches nothing.
   for (const std::uint32_t* const last = block + blocks * Lanes<V>::kCount; block < last; block += Lanes<V>::kCount) {
@@ -259,28 +295,46 @@ template <class V>
     const auto near = d2 < reach_lead * reach_lead;
     // Lists are ordered nearest first: a group's last blocks mostly hold pairs only the skin keeps.
     if (!simd::any(near)) continue;
-    V dvx, dvy, dvz, inv_mj;
-    Lanes<V>::load(s.vel_half, block, dvx, dvy, dvz, inv_mj);
-    dvx -= i.vx, dvy -= i.vy, dvz -= i.vz;
-    const V inv_dist = simd::rsqrt(max(d2, tiny));
-    const V overlap = reach - d2 * inv_dist;
-    const V v_n = mul_add(dvz, dz, mul_add(dvy, dy, dvx * dx)) * inv_dist;
+    const BlockPairs<V> p = block_pairs(s, block, i, dx, dy, dz, d2, reach);
+    // Lanes that are not near cannot start within the step (lead_bound bounds every lead).
+    const auto whole_law = starting_or_ending(m, p.overlap, p.v_n);
     V f;
-    // Lanes that are not near cannot start within the step (lead_bound bounds every lead): not masked.
-    if (simd::any(starting_or_ending(m, overlap, v_n))) [[unlikely]] {
-      V c = kind_c[0];
-      for (int k = 1; k < kKindCount; ++k) c = select(inv_mj == kind_inv_m[k], kind_c[k], c);
-      f = keep(near, normal_force(m, overlap, v_n, c, i.inv_m + inv_mj));
+    if (!kDefer && simd::any(whole_law)) [[unlikely]] {
+      f = keep(near, normal_force(m, p.overlap, p.v_n, pair_c(i, p.inv_mj), i.inv_m + p.inv_mj));
     } else {
       V damping = kind_damping[0];
-      for (int k = 1; k < kKindCount; ++k) damping = select(inv_mj == kind_inv_m[k], kind_damping[k], damping);
-      f = whole_or_no_contact_force(m, overlap, v_n, damping);
+      for (int k = 1; k < kKindCount; ++k)
+        damping = select(p.inv_mj == V::splat(1.0f / kBallKinds[k].mass), kind_damping[k], damping);
+      f = whole_or_no_contact_force(m, p.overlap, p.v_n, damping);
+      if constexpr (kDefer) {  // those lanes' force comes from whole_law_forces
+        f = select(whole_law, V::zero(), f);
+        *deferred = {block, share};
+        deferred += simd::any(whole_law);
+      }
     }
-    const V f_over_dist = f * inv_dist;
+    const V f_over_dist = f * p.inv_dist;
     fx = neg_mul_add(f_over_dist, dx, fx);
     fy = neg_mul_add(f_over_dist, dy, fy);
     fz = neg_mul_add(f_over_dist, dz, fz);
   }
+}
+
+// The whole law's force on the lanes of one deferred block whose contact starts or ends, added to f.
+template <class V>
+[[gnu::always_inline]] inline void whole_law_forces(const StepArrays& s, const ContactModel& m,
+                                                    const std::uint32_t* block, const GroupBalls<V>& i, V (&f)[3]) {
+  V dx, dy, dz, rj;
+  Lanes<V>::load(s.pos, block, dx, dy, dz, rj);
+  dx -= i.x, dy -= i.y, dz -= i.z;
+  const V d2 = mul_add(dz, dz, mul_add(dy, dy, dx * dx));
+  const V reach = rj + i.r, reach_lead = reach + V::splat(m.lead_bound);
+  const BlockPairs<V> p = block_pairs(s, block, i, dx, dy, dz, d2, reach);
+  const auto lanes = (d2 < reach_lead * reach_lead) & starting_or_ending(m, p.overlap, p.v_n);
+  const V f_over_dist =
+      keep(lanes, normal_force(m, p.overlap, p.v_n, pair_c(i, p.inv_mj), i.inv_m + p.inv_mj)) * p.inv_dist;
+  f[0] = neg_mul_add(f_over_dist, dx, f[0]);
+  f[1] = neg_mul_add(f_over_dist, dy, f[1]);
+  f[2] = neg_mul_add(f_over_dist, dz, f[2]);
 }
 
 // One axis of the six half-space walls: below the minimum face the force
@@ -404,7 +458,9 @@ template <std::uint32_t kCount>
 }
 
 // A batch's groups, one ball per lane: a = F / m + g, then per_group(at, i, ax, ay, az, record)
-// does the rest for the balls at list entries `at`.
+// does the rest for the balls at list entries `at`. While the balls move (kStillLead), the blocks
+// in which a contact starts or ends are summed after all the batch's others, one branch-free pass
+// listing them: each group's a waits for that.
 template <class V, class PerGroup>
 [[gnu::always_inline]] inline void for_each_group_of_batch(const StepArrays& s, const GroupLists& lists,
                                                            const PrefetchPlan& plan, const ContactModel& m,
@@ -414,26 +470,56 @@ template <class V, class PerGroup>
   const std::uint32_t* block = lists.neighbours + std::size_t(batch) * lists.stride;
   const std::uint32_t groups = grouped_length(batch_end(batch, end) - batch, kCount) / kCount;
   const std::uint32_t* const group_blocks = lists.blocks + batch / kCount;
-  const std::uint32_t* record = lists.records + 4 * std::size_t(batch);
+  const std::uint32_t* const record = lists.records + 4 * std::size_t(batch);
   // Decided once per batch: most batches are in no fetch's window (all, on one thread).
   const std::uint32_t batch_number = batch / kStepBatch;
   const bool fetching = in_window(plan.edge_fetch[0], batch_number) || in_window(plan.edge_fetch[1], batch_number);
   const KindDamping kinds(m);
-  for (std::uint32_t share = 0; share < groups; ++share, record += 4 * kCount) {
+  // Asks for what later groups need, and loads the group's balls.
+  const auto start_group = [&](std::uint32_t share) {
     if (plan.beyond_cache) prefetch_batch_ahead<kCount>(s, lists, plan, batch, share);
     if (fetching)
       for (const RowFetch& f : plan.edge_fetch) fetch_rows<kCount>(s, f, batch_number, share);
-    const std::uint32_t blocks = group_blocks[share];
-    const std::uint32_t* const at = record + 3 * kCount;  // the group's list entries
+    const std::uint32_t* const at = record + 4 * kCount * share + 3 * kCount;  // the group's list entries
     GroupBalls<V> i;
     i.kinds = &kinds;
     Lanes<V>::load(s.pos, at, i.x, i.y, i.z, i.r);
     Lanes<V>::load(s.vel_half, at, i.vx, i.vy, i.vz, i.inv_m);
-    V ax, ay, az;
-    neighbour_forces(s, m, block, blocks, i, ax, ay, az);
-    acceleration(s, m, i, ax, ay, az);
-    per_group(at, i, ax, ay, az, record);
-    block += std::size_t(blocks) * kCount;
+    return i;
+  };
+  if (m.lead_bound < kStillLead) {  // each group in turn, blocks in which a contact starts or ends too
+    for (std::uint32_t share = 0; share < groups; ++share) {
+      GroupBalls<V> i = start_group(share);
+      const std::uint32_t* const group_record = record + 4 * kCount * share;
+      V ax, ay, az;
+      WholeLawBlock* none = nullptr;
+      neighbour_forces<false>(s, m, block, group_blocks[share], i, ax, ay, az, share, none);
+      acceleration(s, m, i, ax, ay, az);
+      per_group(group_record + 3 * kCount, i, ax, ay, az, group_record);
+      block += std::size_t(group_blocks[share]) * kCount;
+    }
+    return;
+  }
+  // Each group's balls and forces are held while the blocks in which a contact starts or ends are summed.
+  constexpr std::uint32_t kGroups = kStepBatch / kCount;
+  GroupBalls<V> balls[kGroups];
+  V force[kGroups][3];
+  thread_local std::vector<WholeLawBlock> whole_law;
+  whole_law.resize(std::max<std::size_t>(whole_law.size(), std::size_t(groups) * lists.stride + 1));
+  WholeLawBlock* deferred = whole_law.data();
+  for (std::uint32_t share = 0; share < groups; ++share) {
+    balls[share] = start_group(share);
+    V(&f)[3] = force[share];
+    neighbour_forces<true>(s, m, block, group_blocks[share], balls[share], f[0], f[1], f[2], share, deferred);
+    block += std::size_t(group_blocks[share]) * kCount;
+  }
+  for (const WholeLawBlock* b = whole_law.data(); b < deferred; ++b)
+    whole_law_forces(s, m, b->block, balls[b->share], force[b->share]);
+  for (std::uint32_t share = 0; share < groups; ++share) {
+    const std::uint32_t* const group_record = record + 4 * kCount * share;
+    V(&f)[3] = force[share];
+    acceleration(s, m, balls[share], f[0], f[1], f[2]);
+    per_group(group_record + 3 * kCount, balls[share], f[0], f[1], f[2], group_record);
   }
 }
 
