@@ -190,35 +190,102 @@ std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t
 template <class V>
 struct Lanes;
 
+// c and c / (1 + beta) (contact_law.h) of each pair of ball kinds, and of each
+// kind against a wall or a player (kinematic: m_eff = m). Made once per batch
+// with the scalar law, the same values each lane would compute: a group then
+// picks its lanes' rows instead of taking square roots and quotients.
+struct KindDamping {
+  float c[kKindCount][kKindCount], damping[kKindCount][kKindCount];  // [kind of i][kind of j]
+  float kinematic_c[kKindCount], kinematic_damping[kKindCount];
+
+  explicit KindDamping(const ContactModel& m) {
+    for (int a = 0; a < kKindCount; ++a) {
+      const float inv_m = 1.0f / kBallKinds[a].mass;
+      kinematic_c[a] = contact_damping(m, inv_m);
+      kinematic_damping[a] = whole_step_damping(m, kinematic_c[a], inv_m);
+      for (int b = 0; b < kKindCount; ++b) {
+        const float inv_m_sum = inv_m + 1.0f / kBallKinds[b].mass;
+        c[a][b] = contact_damping(m, inv_m_sum);
+        damping[a][b] = whole_step_damping(m, c[a][b], inv_m_sum);
+      }
+    }
+  }
+};
+
+// Each lane's entry of a per-kind row; a ball's kind is known by its 1 / mass.
+template <class V>
+[[gnu::always_inline]] inline V of_lane_kinds(V inv_m, const float (&of_kind)[kKindCount]) {
+  V value = V::splat(of_kind[0]);
+  for (int k = 1; k < kKindCount; ++k)
+    value = select(inv_m == V::splat(1.0f / kBallKinds[k].mass), V::splat(of_kind[k]), value);
+  return value;
+}
+
 // A group's balls, one per lane.
 template <class V>
 struct GroupBalls {
   V x, y, z, r;  // position, radius
   V vx, vy, vz;  // half-step velocity
   V inv_m;       // 1 / mass
+  const KindDamping* kinds;
 };
 
-// Sum over each lane's neighbours of the contact force, into fx, fy, fz, in
-// list order as in the scalar twin. d points from ball i to its neighbour.
-// Most blocks hold contacts that last the whole step (or none): their law is
-// k x - damping v_n, with damping taken by the neighbour's kind from a table
-// made once per group; a block with a contact starting or ending takes the
-// whole law (contact_law.h). Both give the scalar twin's value to float rounding.
+// Below this lead bound (every ball nearly at rest), contacts that start or end are too rare to pay for
+// deferring them (neighbour_forces); in a moving pile they are common.
+constexpr float kStillLead = 1e-3f;
+
+// A block of a group's lists in which some lane's contact starts or ends.
+struct WholeLawBlock {
+  const std::uint32_t* block;
+  std::uint32_t share;  // the group's place in its batch
+};
+
+// Where a block's neighbours are and how they move, seen from the group's balls.
 template <class V>
+struct BlockPairs {
+  V dx, dy, dz;  // from ball i to its neighbour
+  V inv_dist, overlap, v_n;
+  V inv_mj;  // the neighbour's 1 / mass
+};
+
+template <class V>
+[[gnu::always_inline]] inline BlockPairs<V> block_pairs(const StepArrays& s, const std::uint32_t* block,
+                                                        const GroupBalls<V>& i, V dx, V dy, V dz, V d2, V reach) {
+  const V tiny = V::splat(1e-12f);  // squared distance floor: coincident centres stay finite
+  V dvx, dvy, dvz, inv_mj;
+  Lanes<V>::load(s.vel_half, block, dvx, dvy, dvz, inv_mj);
+  dvx -= i.vx, dvy -= i.vy, dvz -= i.vz;
+  const V inv_dist = simd::rsqrt(max(d2, tiny));
+  return {dx, dy, dz, inv_dist, reach - d2 * inv_dist, mul_add(dvz, dz, mul_add(dvy, dy, dvx * dx)) * inv_dist, inv_mj};
+}
+
+// c of each lane's pair with its neighbour of 1 / mass inv_mj.
+template <class V>
+[[gnu::always_inline]] inline V pair_c(const GroupBalls<V>& i, V inv_mj) {
+  V c = V::zero();
+  for (int k = 0; k < kKindCount; ++k)  // the tables are symmetric
+    c = select(inv_mj == V::splat(1.0f / kBallKinds[k].mass), of_lane_kinds(i.inv_m, i.kinds->c[k]), c);
+  return c;
+}
+
+// Sum over each lane's neighbours of the contact force, into fx, fy, fz, in
+// list order as in the scalar twin (deferred lanes after the rest). Most
+// contacts last the whole step (or are none): their law is k x - damping v_n,
+// with damping taken by the neighbour's kind from a table made once per group.
+// A lane whose contact starts or ends takes the whole law (contact_law.h): in
+// its block's turn (kDefer false), or later, in whole_law_forces, its block
+// listed at `deferred` (kDefer true): where a pile moves, a branch per block
+// on whether it holds one would be mispredicted often.
+template <bool kDefer, class V>
 [[gnu::always_inline]] inline void neighbour_forces(const StepContext& ctx, const std::uint32_t* block,
-                                                    std::uint32_t blocks, const GroupBalls<V>& i, V& fx, V& fy, V& fz) {
+                                                    std::uint32_t blocks, const GroupBalls<V>& i, V& fx, V& fy, V& fz,
+                                                    std::uint32_t share, WholeLawBlock*& deferred) {
   const StepArrays& s = ctx.arrays;
   const ContactModel& m = ctx.model;
-  // A neighbour's kind is known by its 1 / mass: c and c / (1 + beta) of each pair, once per group.
-  V kind_inv_m[kKindCount], kind_c[kKindCount], kind_damping[kKindCount];
-  for (int k = 0; k < kKindCount; ++k) {
-    kind_inv_m[k] = V::splat(1.0f / kBallKinds[k].mass);
-    const V inv_m_sum = i.inv_m + kind_inv_m[k];
-    kind_c[k] = contact_damping(m, inv_m_sum);
-    kind_damping[k] = whole_step_damping(m, kind_c[k], inv_m_sum);
-  }
+  // A neighbour's kind is known by its 1 / mass: c / (1 + beta) of each lane's pair with each kind.
+  V kind_damping[kKindCount];
+  for (int k = 0; k < kKindCount; ++k) kind_damping[k] = of_lane_kinds(i.inv_m, i.kinds->damping[k]);
   const V lead_bound = V::splat(m.lead_bound);
-  const V tiny = V::splat(1e-12f);  // squared distance floor: coincident centres stay finite
   fx = fy = fz = V::zero();
   // Past its end, a shorter list's lane holds the ghost: it touches nothing.
   for (const std::uint32_t* const last = block + blocks * Lanes<V>::kCount; block < last; block += Lanes<V>::kCount) {
@@ -230,35 +297,64 @@ template <class V>
     const auto near = d2 < reach_lead * reach_lead;
     // Lists are ordered nearest first: a group's last blocks mostly hold pairs only the skin keeps.
     if (!simd::any(near)) continue;
-    V dvx, dvy, dvz, inv_mj;
-    Lanes<V>::load(s.vel_half, block, dvx, dvy, dvz, inv_mj);
-    dvx -= i.vx, dvy -= i.vy, dvz -= i.vz;
-    const V inv_dist = simd::rsqrt(max(d2, tiny));
-    const V overlap = reach - d2 * inv_dist;
-    const V v_n = mul_add(dvz, dz, mul_add(dvy, dy, dvx * dx)) * inv_dist;
+    const BlockPairs<V> p = block_pairs(s, block, i, dx, dy, dz, d2, reach);
+    // Lanes that are not near cannot start within the step (lead_bound bounds every lead).
+    const auto whole_law = starting_or_ending(m, p.overlap, p.v_n);
     V f;
-    if (simd::any(near & starting_or_ending(m, overlap, v_n))) [[unlikely]] {
-      V c = kind_c[0];
-      for (int k = 1; k < kKindCount; ++k) c = select(inv_mj == kind_inv_m[k], kind_c[k], c);
-      f = keep(near, normal_force(m, overlap, v_n, c, i.inv_m + inv_mj));
+    if (!kDefer && simd::any(whole_law)) [[unlikely]] {
+      f = keep(near, normal_force(m, p.overlap, p.v_n, pair_c(i, p.inv_mj), i.inv_m + p.inv_mj));
     } else {
       V damping = kind_damping[0];
-      for (int k = 1; k < kKindCount; ++k) damping = select(inv_mj == kind_inv_m[k], kind_damping[k], damping);
-      f = whole_or_no_contact_force(m, overlap, v_n, damping);
+      for (int k = 1; k < kKindCount; ++k)
+        damping = select(p.inv_mj == V::splat(1.0f / kBallKinds[k].mass), kind_damping[k], damping);
+      f = whole_or_no_contact_force(m, p.overlap, p.v_n, damping);
+      if constexpr (kDefer) {  // those lanes' force comes from whole_law_forces
+        f = select(whole_law, V::zero(), f);
+        *deferred = {block, share};
+        deferred += simd::any(whole_law);
+      }
     }
-    const V f_over_dist = f * inv_dist;
+    const V f_over_dist = f * p.inv_dist;
     fx = neg_mul_add(f_over_dist, dx, fx);
     fy = neg_mul_add(f_over_dist, dy, fy);
     fz = neg_mul_add(f_over_dist, dz, fz);
   }
 }
 
-// One axis of the six half-space walls: below the minimum face the force
-// points +axis, above the maximum face -axis; both grow with depth.
+// The whole law's force on the lanes of one deferred block whose contact starts or ends, added to f.
 template <class V>
-[[gnu::always_inline]] inline V wall_force(const ContactModel& m, V c, V inv_m, V p, V v, V r, float lo, float hi) {
-  return normal_force(m, V::splat(lo) + r - p, v, c, inv_m) -
-         normal_force(m, p + r - V::splat(hi), V::zero() - v, c, inv_m);
+[[gnu::always_inline]] inline void whole_law_forces(const StepContext& ctx, const std::uint32_t* block,
+                                                    const GroupBalls<V>& i, V (&f)[3]) {
+  const StepArrays& s = ctx.arrays;
+  const ContactModel& m = ctx.model;
+  V dx, dy, dz, rj;
+  Lanes<V>::load(s.pos, block, dx, dy, dz, rj);
+  dx -= i.x, dy -= i.y, dz -= i.z;
+  const V d2 = mul_add(dz, dz, mul_add(dy, dy, dx * dx));
+  const V reach = rj + i.r, reach_lead = reach + V::splat(m.lead_bound);
+  const BlockPairs<V> p = block_pairs(s, block, i, dx, dy, dz, d2, reach);
+  const auto lanes = (d2 < reach_lead * reach_lead) & starting_or_ending(m, p.overlap, p.v_n);
+  const V f_over_dist =
+      keep(lanes, normal_force(m, p.overlap, p.v_n, pair_c(i, p.inv_mj), i.inv_m + p.inv_mj)) * p.inv_dist;
+  f[0] = neg_mul_add(f_over_dist, dx, f[0]);
+  f[1] = neg_mul_add(f_over_dist, dy, f[1]);
+  f[2] = neg_mul_add(f_over_dist, dz, f[2]);
+}
+
+// One axis of the six half-space walls: below the minimum face the force
+// points +axis, above the maximum face -axis; both grow with depth. A ball
+// reaches one face of an axis at most, so the law runs once, on the nearer
+// face (the other's force is zero); where no lane's contact starts or ends
+// there, it is k x - damping v_n with the group's damping (contact_law.h).
+template <class V>
+[[gnu::always_inline]] inline V wall_force(const ContactModel& m, V c, V damping, V inv_m, V p, V v, V r, float lo,
+                                           float hi) {
+  const V below = V::splat(lo) + r - p, above = p + r - V::splat(hi);
+  const auto lower = below > above;
+  const V overlap = select(lower, below, above), v_n = select(lower, v, V::zero() - v);
+  const V f = simd::any(starting_or_ending(m, overlap, v_n)) ? normal_force(m, overlap, v_n, c, inv_m)
+                                                             : whole_or_no_contact_force(m, overlap, v_n, damping);
+  return select(lower, f, V::zero() - f);
 }
 
 // a = F / m + g for a group's balls: their neighbours' forces f, plus player
@@ -269,12 +365,12 @@ template <class V>
   const ContactModel& m = ctx.model;
   const TankBounds& t = s.tank;
   const V r = i.r, reach = r + V::splat(m.lead_bound);
-  const auto near_wall = (V::splat(t.min.x) + reach > i.x) | (i.x + reach > V::splat(t.max.x)) |
-                         (V::splat(t.min.y) + reach > i.y) | (i.y + reach > V::splat(t.max.y)) |
-                         (V::splat(t.min.z) + reach > i.z) | (i.z + reach > V::splat(t.max.z));
-  const bool walls = simd::any(near_wall);  // most groups touch no wall
+  const auto near_x = (V::splat(t.min.x) + reach > i.x) | (i.x + reach > V::splat(t.max.x));
+  const auto near_y = (V::splat(t.min.y) + reach > i.y) | (i.y + reach > V::splat(t.max.y));
+  const auto near_z = (V::splat(t.min.z) + reach > i.z) | (i.z + reach > V::splat(t.max.z));
+  const bool walls = simd::any(near_x | near_y | near_z);  // most groups touch no wall
   if (walls || s.players > 0) {
-    const V c = contact_damping(m, i.inv_m);  // walls and players are kinematic: m_eff = m
+    const V c = of_lane_kinds(i.inv_m, i.kinds->kinematic_c);
     for (int p = 0; p < s.players; ++p) {
       const Float4 pj = s.player_pos[p], vj = s.player_vel[p];
       const V dx = V::splat(pj.x) - i.x, dy = V::splat(pj.y) - i.y, dz = V::splat(pj.z) - i.z;
@@ -291,10 +387,11 @@ template <class V>
       fy = neg_mul_add(f_over_dist, dy, fy);
       fz = neg_mul_add(f_over_dist, dz, fz);
     }
-    if (walls) {
-      fx += wall_force(m, c, i.inv_m, i.x, i.vx, r, t.min.x, t.max.x);
-      fy += wall_force(m, c, i.inv_m, i.y, i.vy, r, t.min.y, t.max.y);
-      fz += wall_force(m, c, i.inv_m, i.z, i.vz, r, t.min.z, t.max.z);
+    if (walls) {  // an axis no lane is near adds zero
+      const V damping = of_lane_kinds(i.inv_m, i.kinds->kinematic_damping);
+      if (simd::any(near_x)) fx += wall_force(m, c, damping, i.inv_m, i.x, i.vx, r, t.min.x, t.max.x);
+      if (simd::any(near_y)) fy += wall_force(m, c, damping, i.inv_m, i.y, i.vy, r, t.min.y, t.max.y);
+      if (simd::any(near_z)) fz += wall_force(m, c, damping, i.inv_m, i.z, i.vz, r, t.min.z, t.max.z);
     }
   }
   fx = fx * i.inv_m;
@@ -367,34 +464,69 @@ template <std::uint32_t kCount>
 }
 
 // A batch's groups, one ball per lane: a = F / m + g, then per_group(at, i, ax, ay, az, record)
-// does the rest for the balls at list entries `at`.
+// does the rest for the balls at list entries `at`. While the balls move (kStillLead), the blocks
+// in which a contact starts or ends are summed after all the batch's others, one branch-free pass
+// listing them: each group's a waits for that.
 template <class V, class PerGroup>
 [[gnu::always_inline]] inline void for_each_group_of_batch(const StepContext& ctx, const GroupLists& lists,
                                                            const EdgeFetches& edges, std::uint32_t batch,
                                                            std::uint32_t end, PerGroup& per_group) {
   const StepArrays& s = ctx.arrays;
+  const ContactModel& m = ctx.model;
   constexpr std::uint32_t kCount = Lanes<V>::kCount;
   const std::uint32_t* block = lists.neighbours + std::size_t(batch) * lists.stride;
   const std::uint32_t groups = grouped_length(batch_end(batch, end) - batch, kCount) / kCount;
   const std::uint32_t* const group_blocks = lists.blocks + batch / kCount;
-  const std::uint32_t* record = lists.records + 4 * std::size_t(batch);
+  const std::uint32_t* const record = lists.records + 4 * std::size_t(batch);
   // Decided once per batch: most batches are in no fetch's window (all, on one thread).
   const std::uint32_t batch_number = batch / kStepBatch;
   const bool fetching = in_window(edges.rows[0], batch_number) || in_window(edges.rows[1], batch_number);
-  for (std::uint32_t share = 0; share < groups; ++share, record += 4 * kCount) {
+  const KindDamping kinds(m);
+  // Asks for what later groups need, and loads the group's balls.
+  const auto start_group = [&](std::uint32_t share) {
     if (ctx.plan.beyond_cache) prefetch_batch_ahead<kCount>(ctx, lists, batch, share);
     if (fetching)
       for (const RowFetch& f : edges.rows) fetch_rows<kCount>(s, f, batch_number, share);
-    const std::uint32_t blocks = group_blocks[share];
-    const std::uint32_t* const at = record + 3 * kCount;  // the group's list entries
+    const std::uint32_t* const at = record + 4 * kCount * share + 3 * kCount;  // the group's list entries
     GroupBalls<V> i;
+    i.kinds = &kinds;
     Lanes<V>::load(s.pos, at, i.x, i.y, i.z, i.r);
     Lanes<V>::load(s.vel_half, at, i.vx, i.vy, i.vz, i.inv_m);
-    V ax, ay, az;
-    neighbour_forces(ctx, block, blocks, i, ax, ay, az);
-    acceleration(ctx, i, ax, ay, az);
-    per_group(at, i, ax, ay, az, record);
-    block += std::size_t(blocks) * kCount;
+    return i;
+  };
+  if (m.lead_bound < kStillLead) {  // each group in turn, blocks in which a contact starts or ends too
+    for (std::uint32_t share = 0; share < groups; ++share) {
+      GroupBalls<V> i = start_group(share);
+      const std::uint32_t* const group_record = record + 4 * kCount * share;
+      V ax, ay, az;
+      WholeLawBlock* none = nullptr;
+      neighbour_forces<false>(ctx, block, group_blocks[share], i, ax, ay, az, share, none);
+      acceleration(ctx, i, ax, ay, az);
+      per_group(group_record + 3 * kCount, i, ax, ay, az, group_record);
+      block += std::size_t(group_blocks[share]) * kCount;
+    }
+    return;
+  }
+  // Each group's balls and forces are held while the blocks in which a contact starts or ends are summed.
+  constexpr std::uint32_t kGroups = kStepBatch / kCount;
+  GroupBalls<V> balls[kGroups];
+  V force[kGroups][3];
+  thread_local std::vector<WholeLawBlock> whole_law;
+  whole_law.resize(std::max<std::size_t>(whole_law.size(), std::size_t(groups) * lists.stride + 1));
+  WholeLawBlock* deferred = whole_law.data();
+  for (std::uint32_t share = 0; share < groups; ++share) {
+    balls[share] = start_group(share);
+    V(&f)[3] = force[share];
+    neighbour_forces<true>(ctx, block, group_blocks[share], balls[share], f[0], f[1], f[2], share, deferred);
+    block += std::size_t(group_blocks[share]) * kCount;
+  }
+  for (const WholeLawBlock* b = whole_law.data(); b < deferred; ++b)
+    whole_law_forces(ctx, b->block, balls[b->share], force[b->share]);
+  for (std::uint32_t share = 0; share < groups; ++share) {
+    const std::uint32_t* const group_record = record + 4 * kCount * share;
+    V(&f)[3] = force[share];
+    acceleration(ctx, balls[share], f[0], f[1], f[2]);
+    per_group(group_record + 3 * kCount, balls[share], f[0], f[1], f[2], group_record);
   }
 }
 
