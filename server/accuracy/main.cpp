@@ -43,9 +43,21 @@ struct Options {
   const Kernels* kernels = &kSseKernels;
 };
 
-bool parse(int argc, char** argv, Options& o) {
+constexpr const char* kUsage =
+    "usage: fishtank-accuracy [--out DIR] [--quick] [--scalar | --avx2] [--collisions-only]\n"
+    "The measurements behind docs/accuracy.md: single collisions against the contact model's exact e,\n"
+    "rows of balls, error against dt for each scheme, and the stability map, as CSV files in DIR.\n"
+    "  --out DIR          where the CSV files go (default .)\n"
+    "  --quick            a coarse sweep, a few seconds\n"
+    "  --scalar, --avx2   those kernels instead of the SSE ones fishtank-server ships\n"
+    "  --collisions-only  only collisions.csv and restitutions.csv (the tolerance rule)\n";
+
+// 0: run; 1: --help was asked; -1: a bad argument, named on stderr.
+int parse(int argc, char** argv, Options& o) {
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--out") && i + 1 < argc)
+    if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h"))
+      return 1;
+    else if (!std::strcmp(argv[i], "--out") && i + 1 < argc)
       o.out = argv[++i];
     else if (!std::strcmp(argv[i], "--quick"))
       o.quick = true;
@@ -55,10 +67,12 @@ bool parse(int argc, char** argv, Options& o) {
       o.kernels = &kScalarKernels;
     else if (!std::strcmp(argv[i], "--avx2"))
       o.kernels = &kAvx2Kernels;
-    else
-      return false;
+    else {
+      std::fprintf(stderr, "fishtank-accuracy: unknown argument '%s'\n", argv[i]);
+      return -1;
+    }
   }
-  return true;
+  return 0;
 }
 
 std::ofstream open_csv(const Options& o, const char* name, const char* header) {
@@ -198,9 +212,9 @@ void run_stability(const Options& o) {
 
 int main(int argc, char** argv) {
   Options o;
-  if (!parse(argc, argv, o)) {
-    std::fprintf(stderr, "usage: fishtank-accuracy [--out DIR] [--quick] [--scalar | --avx2] [--collisions-only]\n");
-    return 2;
+  if (const int parsed = parse(argc, argv, o); parsed != 0) {
+    std::fputs(kUsage, parsed > 0 ? stdout : stderr);
+    return parsed > 0 ? 0 : 2;
   }
   if (o.kernels == &kAvx2Kernels && !cpu_has_avx2()) {
     std::fprintf(stderr, "fishtank-accuracy: this processor has no AVX2; leave out --avx2\n");
