@@ -215,6 +215,11 @@ class Variant:
         # row would no longer be what its label says.
         return ["--threads", str(self.threads)] + (["--fixed-threads"] if self.threads > 1 else [])
 
+    @property
+    def simd(self):
+        """The kernel set the program steps with: "scalar", "sse" or "avx2"."""
+        return {"fishtank-server-scalar": "scalar", "fishtank-server": "sse", "fishtank-server-avx2": "avx2"}[self.program]
+
     def bench_command(self, build, *args):
         return [os.path.join(build, "server", self.program), "--bench", *map(str, args), *self.flags]
 
@@ -232,6 +237,11 @@ def variants(avx2_one_thread=False):
         if n > 1:
             cases.append(Variant(f"AVX2 {n} threads", "fishtank-server-avx2", n))
     return cases
+
+
+def simd_variants_on_every_core():
+    """The SIMD builds on every core (--fixed-threads): the variants whose rate the tolerance turns into capacity."""
+    return [v for v in variants() if v.threads == cores() and v.simd != "scalar"]
 
 
 def build_targets(build, *extra):
