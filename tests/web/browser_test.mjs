@@ -101,11 +101,15 @@ test('two tabs see one world: each sees the other\'s player, and one tab\'s move
   assert.ok(s2.players.some((p) => p.id === s1.playerId), 'tab 2 sees tab 1\'s player');
   assert.equal(s2.serverBalls, s1.serverBalls, 'the same balls');
   const x0 = s1.players.find((p) => p.id === s2.playerId).pos[0];
+  // Held until tab 1 sees the move: a software-rendered page may take seconds to send its first input.
+  await second.bringToFront();
   await second.keyboard.down('KeyA');
-  await sleep(800);
-  await second.keyboard.up('KeyA');
-  await waitForState(page, (st) => st.players.find((p) => p.id === s2.playerId).pos[0] < x0 - 2,
-                     'tab 1 sees tab 2\'s player move 2 m along -x');
+  try {
+    await waitForState(page, (st) => st.players.find((p) => p.id === s2.playerId).pos[0] < x0 - 2,
+                       'tab 1 sees tab 2\'s player move 2 m along -x');
+  } finally {
+    await second.keyboard.up('KeyA');
+  }
   await second.close();
 });
 
