@@ -2,8 +2,10 @@
 // Multi-contact collisions, where no step can be exact: a ball hits a row of
 // touching balls of diameter 1 on the x axis, a three-ball chain (two in the
 // row) or a five-ball Newton's cradle (four). The reference integrates the
-// same contact law in double with RK4 at t_c / 40 000; the World's error is
-// its largest final velocity difference over the approach speed.
+// same contact law in double with RK4 at t_c / 4000, each contact's onset and
+// release located to round-off and stepped to, so its final velocities are
+// good to about 1e-13; the World's error is its largest final velocity
+// difference over the approach speed.
 
 #include <vector>
 
