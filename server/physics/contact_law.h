@@ -19,8 +19,12 @@
 // and the spring's impulse is k times the overlap's integral over the part of
 // the window in contact (a triangle where it starts or ends, x itself where it
 // lasts). Where it starts or ends, the lead is taken once more from the rate at
-// mid-window, after the spring's half kick: start and end then mirror each
-// other, and an elastic contact neither gains nor loses energy on average.
+// mid-window, after the half kick of the spring and of the pair's other forces
+// (other contacts, gravity): start and end then mirror each other, and an
+// elastic contact neither gains nor loses energy on average, alone or in a
+// group of touching balls. The other forces are the pair's relative acceleration
+// over the last step less this contact's own then, which the law recomputes from
+// the overlap and rate of a step before.
 // The dashpot acts over that part, f dt, on the relative speed solved
 // implicitly for this contact alone: beta = c f dt / (2 m_eff) and
 //   F = k mean_overlap - c f / (1 + beta) v_n.
@@ -31,7 +35,9 @@
 // which leaves each collision's restitution second order in dt.
 //
 // x is the overlap (negative: the gap), v_n the rate at which the gap opens,
-// inv_m_sum the pair's 1 / m_eff (a wall or a player adds 0).
+// inv_m_sum the pair's 1 / m_eff (a wall or a player adds 0), last_accel the
+// rate's change per second over the last step (the pair's relative acceleration
+// along the normal, from StepArrays::vel_half_before).
 
 #include <algorithm>
 #include <cmath>
@@ -69,14 +75,33 @@ inline WindowContact window_contact(float overlap, float lead) {
   return {fraction, fraction < 1.0f ? 0.5f * reach_in * fraction : overlap};
 }
 
-inline float normal_force(const ContactModel& m, float overlap, float v_n, float c, float inv_m_sum) {
+// The window where a contact starts or ends, from the pair's rate v_n and its other forces' acceleration.
+inline WindowContact partial_window(const ContactModel& m, float overlap, float v_n, float inv_m_sum, float other) {
+  const WindowContact part = window_contact(overlap, std::fabs(v_n + other * m.half_dt) * m.half_dt);
+  const float v_mid = v_n + (m.k * part.mean_overlap * inv_m_sum + other) * m.half_dt;  // after the half kick
+  return window_contact(overlap, std::fabs(v_mid) * m.half_dt);
+}
+
+inline float law_in_window(const ContactModel& m, WindowContact part, float v_n, float c, float inv_m_sum) {
+  return m.k * part.mean_overlap - whole_step_damping(m, c * part.fraction, inv_m_sum) * v_n;
+}
+
+// The law for a pair alone (no other forces): this contact's own force a step before.
+inline float lone_pair_force(const ContactModel& m, float overlap, float v_n, float c, float inv_m_sum) {
+  WindowContact part = window_contact(overlap, std::fabs(v_n) * m.half_dt);
+  if (part.fraction > 0.0f && part.fraction < 1.0f) part = partial_window(m, overlap, v_n, inv_m_sum, 0.0f);
+  return law_in_window(m, part, v_n, c, inv_m_sum);
+}
+
+inline float normal_force(const ContactModel& m, float overlap, float v_n, float c, float inv_m_sum, float last_accel) {
   WindowContact part = window_contact(overlap, std::fabs(v_n) * m.half_dt);
   if (part.fraction > 0.0f && part.fraction < 1.0f) {
-    const float v_mid = v_n + m.k * part.mean_overlap * inv_m_sum * m.half_dt;  // after the spring's half kick
-    part = window_contact(overlap, std::fabs(v_mid) * m.half_dt);
+    // A step before, the overlap was x + v_n dt and the rate v_n - last_accel dt (the drift and kick undone).
+    const float then = overlap + v_n * m.dt, v_then = v_n - last_accel * m.dt;
+    const float own = may_touch(m, then, v_then) ? lone_pair_force(m, then, v_then, c, inv_m_sum) * inv_m_sum : 0.0f;
+    part = partial_window(m, overlap, v_n, inv_m_sum, last_accel - own);
   }
-  const float c_f = c * part.fraction;
-  return m.k * part.mean_overlap - whole_step_damping(m, c_f, inv_m_sum) * v_n;
+  return law_in_window(m, part, v_n, c, inv_m_sum);
 }
 
 namespace {  // compiled with each SIMD file's flags: internal linkage (kernels_simd_ball.h)
@@ -105,16 +130,29 @@ template <class V>
 }
 
 template <class V>
-[[gnu::always_inline]] inline V normal_force(const ContactModel& m, V overlap, V v_n, V c, V inv_m_sum) {
+[[gnu::always_inline]] inline WindowContactV<V> partial_window(const ContactModel& m, V overlap, V v_n, V inv_m_sum,
+                                                               V other) {
   const V half_dt = V::splat(m.half_dt);
-  WindowContactV<V> part = window_contact(overlap, abs(v_n) * half_dt);
-  const auto partial = (part.fraction > V::zero()) & (part.fraction < V::splat(1.0f));
-  const V v_mid = v_n + V::splat(m.k) * part.mean_overlap * inv_m_sum * half_dt;  // after the spring's half kick
-  const WindowContactV<V> mid = window_contact(overlap, abs(v_mid) * half_dt);
-  part.fraction = select(partial, mid.fraction, part.fraction);
-  part.mean_overlap = select(partial, mid.mean_overlap, part.mean_overlap);
-  const V c_f = c * part.fraction;
-  return V::splat(m.k) * part.mean_overlap - whole_step_damping(m, c_f, inv_m_sum) * v_n;
+  const WindowContactV<V> part = window_contact(overlap, abs(v_n + other * half_dt) * half_dt);
+  const V v_mid = v_n + (V::splat(m.k) * part.mean_overlap * inv_m_sum + other) * half_dt;  // after the half kick
+  return window_contact(overlap, abs(v_mid) * half_dt);
+}
+
+template <class V>
+[[gnu::always_inline]] inline V law_in_window(const ContactModel& m, WindowContactV<V> part, V v_n, V c, V inv_m_sum) {
+  return V::splat(m.k) * part.mean_overlap - whole_step_damping(m, c * part.fraction, inv_m_sum) * v_n;
+}
+
+// Lanes where the window holds part of the contact.
+template <class V>
+[[gnu::always_inline]] inline auto is_partial(const WindowContactV<V>& part) {
+  return (part.fraction > V::zero()) & (part.fraction < V::splat(1.0f));
+}
+
+template <class V>
+[[gnu::always_inline]] inline WindowContactV<V> select(decltype(V::zero() < V::zero()) lanes,
+                                                       const WindowContactV<V>& a, const WindowContactV<V>& b) {
+  return {select(lanes, a.fraction, b.fraction), select(lanes, a.mean_overlap, b.mean_overlap)};
 }
 
 // Lanes that start or end touching within half a step, whose force needs the
@@ -129,6 +167,27 @@ template <class V>
 template <class V>
 [[gnu::always_inline]] inline V whole_or_no_contact_force(const ContactModel& m, V overlap, V v_n, V damping) {
   return keep(overlap > V::zero(), V::splat(m.k) * overlap - damping * v_n);
+}
+
+// damping: whole_step_damping(c), the pair's damping where its contact lasts the whole window.
+template <class V>
+[[gnu::always_inline]] inline V lone_pair_force(const ContactModel& m, V overlap, V v_n, V c, V inv_m_sum, V damping) {
+  if (any(starting_or_ending(m, overlap, v_n))) {  // rare: the last step's contact started or ended too
+    const WindowContactV<V> part = window_contact(overlap, abs(v_n) * V::splat(m.half_dt));
+    const WindowContactV<V> mid = partial_window(m, overlap, v_n, inv_m_sum, V::zero());
+    return law_in_window(m, select<V>(is_partial(part), mid, part), v_n, c, inv_m_sum);
+  }
+  return whole_or_no_contact_force(m, overlap, v_n, damping);
+}
+
+template <class V>
+[[gnu::always_inline]] inline V normal_force(const ContactModel& m, V overlap, V v_n, V c, V inv_m_sum, V last_accel) {
+  const V damping = whole_step_damping(m, c, inv_m_sum);
+  const V then = overlap + v_n * V::splat(m.dt), v_then = v_n - last_accel * V::splat(m.dt);
+  const V own = lone_pair_force(m, then, v_then, c, inv_m_sum, damping) * inv_m_sum;  // 0 where the pair did not touch
+  const WindowContactV<V> mid = partial_window(m, overlap, v_n, inv_m_sum, last_accel - own);
+  return select(starting_or_ending(m, overlap, v_n), law_in_window(m, mid, v_n, c, inv_m_sum),
+                whole_or_no_contact_force(m, overlap, v_n, damping));
 }
 
 }  // namespace

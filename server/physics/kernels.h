@@ -9,9 +9,11 @@
 // Velocity Verlet in one pass per step, double-buffered: the pass reads
 // (pos, vel_half) of ball i and its neighbours and writes only ball i's
 // outputs, so chunks run in parallel with no races and no atomics:
-//   a    = F(pos, vel_half) / m + g         (F: the mean force over the step, contact_law.h)
+//   a    = F(pos, vel_half, vel_half_before) / m + g   (F: the mean force over the step, contact_law.h)
 //   v    = vel_half + a dt/2                 (the full step, not stored)
 //   vel_half_next = v + a dt/2,  pos_next = pos + vel_half_next dt
+// vel_half_before, the half-step velocity a step earlier (the buffers rotate),
+// gives the last step's acceleration; only contacts that start or end read it.
 
 #include <cstdint>
 #include <limits>
@@ -28,8 +30,9 @@ struct StepArrays {
   // vx, vy, vz, 1 / mass half a step before: F / m becomes a product, and a
   // pair's effective mass 1 / (1/m1 + 1/m2) one sum.
   const Float4* vel_half = nullptr;
-  Float4* pos_next = nullptr;          // out: position one step later
-  Float4* vel_half_next = nullptr;     // out: velocity half a step later
+  const Float4* vel_half_before = nullptr;  // vel_half a step earlier
+  Float4* pos_next = nullptr;               // out: position one step later
+  Float4* vel_half_next = nullptr;          // out: velocity half a step later
   StepLists lists;                     // full lists, each pair from both sides, in the twin's layout (broadphase.h)
   const Float4* player_pos = nullptr;  // x, y, z, radius
   const Float4* player_vel = nullptr;  // vx, vy, vz, 0: a kinematic body's inverse mass

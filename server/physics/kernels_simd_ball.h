@@ -228,10 +228,26 @@ struct GroupBalls {
   V vx, vy, vz;  // half-step velocity
   V inv_m;       // 1 / mass
   const KindDamping* kinds;
+  const std::uint32_t* at;  // their list entries
 };
 
-// Below this lead bound (every ball nearly at rest), contacts that start or end are too rare to pay for
-// deferring them (neighbour_forces); in a moving pile they are common.
+// Half-step velocities a step earlier (StepArrays::vel_half_before), read only where a contact starts or ends.
+template <class V>
+struct VelocityBefore {
+  V x, y, z;
+};
+
+template <class V>
+[[gnu::always_inline]] inline VelocityBefore<V> velocity_before(const StepArrays& s, const std::uint32_t* at) {
+  VelocityBefore<V> b;
+  V unused;
+  Lanes<V>::load(s.vel_half_before, at, b.x, b.y, b.z, unused);
+  return b;
+}
+
+// Below this lead bound (every ball nearly at rest), contacts that start or end are rare: a branch per block
+// lists them, and each group sums them after its other blocks (neighbour_forces); in a moving pile they are
+// common, listed without a branch, and summed once the batch's other blocks are.
 constexpr float kStillLead = 1e-3f;
 
 // A block of a group's lists in which some lane's contact starts or ends.
@@ -259,6 +275,15 @@ template <class V>
   return {dx, dy, dz, inv_dist, reach - d2 * inv_dist, mul_add(dvz, dz, mul_add(dvy, dy, dvx * dx)) * inv_dist, inv_mj};
 }
 
+// Each lane's pair's last relative acceleration along the normal: the change of its rate over the last step.
+template <class V>
+[[gnu::always_inline]] inline V pair_last_accel(const StepArrays& s, const ContactModel& m, const std::uint32_t* block,
+                                                const GroupBalls<V>& i, const BlockPairs<V>& p) {
+  const VelocityBefore<V> bi = velocity_before<V>(s, i.at), bj = velocity_before<V>(s, block);
+  const V v_n_before = mul_add(bj.z - bi.z, p.dz, mul_add(bj.y - bi.y, p.dy, (bj.x - bi.x) * p.dx)) * p.inv_dist;
+  return (p.v_n - v_n_before) * V::splat(1.0f / m.dt);
+}
+
 // c of each lane's pair with its neighbour of 1 / mass inv_mj.
 template <class V>
 [[gnu::always_inline]] inline V pair_c(const GroupBalls<V>& i, V inv_mj) {
@@ -272,11 +297,12 @@ template <class V>
 // list order as in the scalar twin (deferred lanes after the rest). Most
 // contacts last the whole step (or are none): their law is k x - damping v_n,
 // with damping taken by the neighbour's kind from a table made once per group.
-// A lane whose contact starts or ends takes the whole law (contact_law.h): in
-// its block's turn (kDefer false), or later, in whole_law_forces, its block
-// listed at `deferred` (kDefer true): where a pile moves, a branch per block
-// on whether it holds one would be mispredicted often.
-template <bool kDefer, class V>
+// A lane whose contact starts or ends takes the whole law (contact_law.h)
+// later, in whole_law_forces, its block listed at `deferred`, so that this loop
+// stays short. Where a pile moves such blocks are common and a branch per block
+// would be mispredicted often, so they are listed without one (kBranchFree); at
+// rest they are rare, and a branch skips the listing.
+template <bool kBranchFree, class V>
 [[gnu::always_inline]] inline void neighbour_forces(const StepContext& ctx, const std::uint32_t* block,
                                                     std::uint32_t blocks, const GroupBalls<V>& i, V& fx, V& fy, V& fz,
                                                     std::uint32_t share, WholeLawBlock*& deferred) {
@@ -300,19 +326,17 @@ template <bool kDefer, class V>
     const BlockPairs<V> p = block_pairs(s, block, i, dx, dy, dz, d2, reach);
     // Lanes that are not near cannot start within the step (lead_bound bounds every lead).
     const auto whole_law = starting_or_ending(m, p.overlap, p.v_n);
-    V f;
-    if (!kDefer && simd::any(whole_law)) [[unlikely]] {
-      f = keep(near, normal_force(m, p.overlap, p.v_n, pair_c(i, p.inv_mj), i.inv_m + p.inv_mj));
-    } else {
-      V damping = kind_damping[0];
-      for (int k = 1; k < kKindCount; ++k)
-        damping = select(p.inv_mj == V::splat(1.0f / kBallKinds[k].mass), kind_damping[k], damping);
-      f = whole_or_no_contact_force(m, p.overlap, p.v_n, damping);
-      if constexpr (kDefer) {  // those lanes' force comes from whole_law_forces
-        f = select(whole_law, V::zero(), f);
-        *deferred = {block, share};
-        deferred += simd::any(whole_law);
-      }
+    V damping = kind_damping[0];
+    for (int k = 1; k < kKindCount; ++k)
+      damping = select(p.inv_mj == V::splat(1.0f / kBallKinds[k].mass), kind_damping[k], damping);
+    V f = whole_or_no_contact_force(m, p.overlap, p.v_n, damping);
+    if constexpr (kBranchFree) {  // those lanes' force comes from whole_law_forces
+      f = select(whole_law, V::zero(), f);
+      *deferred = {block, share};
+      deferred += simd::any(whole_law);
+    } else if (simd::any(whole_law)) [[unlikely]] {
+      f = select(whole_law, V::zero(), f);
+      *deferred++ = {block, share};
     }
     const V f_over_dist = f * p.inv_dist;
     fx = neg_mul_add(f_over_dist, dx, fx);
@@ -334,8 +358,9 @@ template <class V>
   const V reach = rj + i.r, reach_lead = reach + V::splat(m.lead_bound);
   const BlockPairs<V> p = block_pairs(s, block, i, dx, dy, dz, d2, reach);
   const auto lanes = (d2 < reach_lead * reach_lead) & starting_or_ending(m, p.overlap, p.v_n);
+  const V last_accel = pair_last_accel(s, m, block, i, p);
   const V f_over_dist =
-      keep(lanes, normal_force(m, p.overlap, p.v_n, pair_c(i, p.inv_mj), i.inv_m + p.inv_mj)) * p.inv_dist;
+      keep(lanes, normal_force(m, p.overlap, p.v_n, pair_c(i, p.inv_mj), i.inv_m + p.inv_mj, last_accel)) * p.inv_dist;
   f[0] = neg_mul_add(f_over_dist, dx, f[0]);
   f[1] = neg_mul_add(f_over_dist, dy, f[1]);
   f[2] = neg_mul_add(f_over_dist, dz, f[2]);
@@ -346,14 +371,20 @@ template <class V>
 // reaches one face of an axis at most, so the law runs once, on the nearer
 // face (the other's force is zero); where no lane's contact starts or ends
 // there, it is k x - damping v_n with the group's damping (contact_law.h).
-template <class V>
-[[gnu::always_inline]] inline V wall_force(const ContactModel& m, V c, V damping, V inv_m, V p, V v, V r, float lo,
-                                           float hi) {
+// before() reads the lanes' velocity along the axis a step earlier, wanted only where a contact starts or ends.
+template <class V, class Before>
+[[gnu::always_inline]] inline V wall_force(const ContactModel& m, V c, V damping, V inv_m, V p, V v, Before before, V r,
+                                           float lo, float hi) {
   const V below = V::splat(lo) + r - p, above = p + r - V::splat(hi);
   const auto lower = below > above;
   const V overlap = select(lower, below, above), v_n = select(lower, v, V::zero() - v);
-  const V f = simd::any(starting_or_ending(m, overlap, v_n)) ? normal_force(m, overlap, v_n, c, inv_m)
-                                                             : whole_or_no_contact_force(m, overlap, v_n, damping);
+  V f;
+  if (simd::any(starting_or_ending(m, overlap, v_n))) {
+    const V a = (v - before()) * V::splat(1.0f / m.dt);  // the last step's acceleration along the axis
+    f = normal_force(m, overlap, v_n, c, inv_m, select(lower, a, V::zero() - a));
+  } else {
+    f = whole_or_no_contact_force(m, overlap, v_n, damping);
+  }
   return select(lower, f, V::zero() - f);
 }
 
@@ -382,16 +413,24 @@ template <class V>
       const V inv_dist = V::splat(1.0f) / dist;
       const V v_n =
           ((V::splat(vj.x) - i.vx) * dx + (V::splat(vj.y) - i.vy) * dy + (V::splat(vj.z) - i.vz) * dz) * inv_dist;
-      const V f_over_dist = keep(near, normal_force(m, r + V::splat(pj.w) - dist, v_n, c, i.inv_m) * inv_dist);
+      // The sphere is kinematic, taken as unaccelerated: the pair's rate changed with the ball's velocity.
+      const VelocityBefore<V> b = velocity_before<V>(s, i.at);
+      const V v_n_before =
+          ((V::splat(vj.x) - b.x) * dx + (V::splat(vj.y) - b.y) * dy + (V::splat(vj.z) - b.z) * dz) * inv_dist;
+      const V a_n = (v_n - v_n_before) * V::splat(1.0f / m.dt);
+      const V f_over_dist = keep(near, normal_force(m, r + V::splat(pj.w) - dist, v_n, c, i.inv_m, a_n) * inv_dist);
       fx = neg_mul_add(f_over_dist, dx, fx);
       fy = neg_mul_add(f_over_dist, dy, fy);
       fz = neg_mul_add(f_over_dist, dz, fz);
     }
     if (walls) {  // an axis no lane is near adds zero
       const V damping = of_lane_kinds(i.inv_m, i.kinds->kinematic_damping);
-      if (simd::any(near_x)) fx += wall_force(m, c, damping, i.inv_m, i.x, i.vx, r, t.min.x, t.max.x);
-      if (simd::any(near_y)) fy += wall_force(m, c, damping, i.inv_m, i.y, i.vy, r, t.min.y, t.max.y);
-      if (simd::any(near_z)) fz += wall_force(m, c, damping, i.inv_m, i.z, i.vz, r, t.min.z, t.max.z);
+      const auto x_before = [&] { return velocity_before<V>(s, i.at).x; };
+      const auto y_before = [&] { return velocity_before<V>(s, i.at).y; };
+      const auto z_before = [&] { return velocity_before<V>(s, i.at).z; };
+      if (simd::any(near_x)) fx += wall_force(m, c, damping, i.inv_m, i.x, i.vx, x_before, r, t.min.x, t.max.x);
+      if (simd::any(near_y)) fy += wall_force(m, c, damping, i.inv_m, i.y, i.vy, y_before, r, t.min.y, t.max.y);
+      if (simd::any(near_z)) fz += wall_force(m, c, damping, i.inv_m, i.z, i.vz, z_before, r, t.min.z, t.max.z);
     }
   }
   fx = fx * i.inv_m;
@@ -482,6 +521,9 @@ template <class V, class PerGroup>
   const std::uint32_t batch_number = batch / kStepBatch;
   const bool fetching = in_window(edges.rows[0], batch_number) || in_window(edges.rows[1], batch_number);
   const KindDamping kinds(m);
+  // The blocks in which a contact starts or ends, of a group (at rest) or of the batch (moving).
+  thread_local std::vector<WholeLawBlock> whole_law;
+  whole_law.resize(std::max<std::size_t>(whole_law.size(), std::size_t(groups) * lists.stride + 1));
   // Asks for what later groups need, and loads the group's balls.
   const auto start_group = [&](std::uint32_t share) {
     if (ctx.plan.beyond_cache) prefetch_batch_ahead<kCount>(ctx, lists, batch, share);
@@ -490,19 +532,21 @@ template <class V, class PerGroup>
     const std::uint32_t* const at = record + 4 * kCount * share + 3 * kCount;  // the group's list entries
     GroupBalls<V> i;
     i.kinds = &kinds;
+    i.at = at;
     Lanes<V>::load(s.pos, at, i.x, i.y, i.z, i.r);
     Lanes<V>::load(s.vel_half, at, i.vx, i.vy, i.vz, i.inv_m);
     return i;
   };
-  if (m.lead_bound < kStillLead) {  // each group in turn, blocks in which a contact starts or ends too
+  if (m.lead_bound < kStillLead) {  // each group in turn, its blocks in which a contact starts or ends after the rest
     for (std::uint32_t share = 0; share < groups; ++share) {
       GroupBalls<V> i = start_group(share);
       const std::uint32_t* const group_record = record + 4 * kCount * share;
-      V ax, ay, az;
-      WholeLawBlock* none = nullptr;
-      neighbour_forces<false>(ctx, block, group_blocks[share], i, ax, ay, az, share, none);
-      acceleration(ctx, i, ax, ay, az);
-      per_group(group_record + 3 * kCount, i, ax, ay, az, group_record);
+      V f[3];
+      WholeLawBlock* deferred = whole_law.data();
+      neighbour_forces<false>(ctx, block, group_blocks[share], i, f[0], f[1], f[2], share, deferred);
+      for (const WholeLawBlock* b = whole_law.data(); b < deferred; ++b) whole_law_forces(ctx, b->block, i, f);
+      acceleration(ctx, i, f[0], f[1], f[2]);
+      per_group(group_record + 3 * kCount, i, f[0], f[1], f[2], group_record);
       block += std::size_t(group_blocks[share]) * kCount;
     }
     return;
@@ -511,8 +555,6 @@ template <class V, class PerGroup>
   constexpr std::uint32_t kGroups = kStepBatch / kCount;
   GroupBalls<V> balls[kGroups];
   V force[kGroups][3];
-  thread_local std::vector<WholeLawBlock> whole_law;
-  whole_law.resize(std::max<std::size_t>(whole_law.size(), std::size_t(groups) * lists.stride + 1));
   WholeLawBlock* deferred = whole_law.data();
   for (std::uint32_t share = 0; share < groups; ++share) {
     balls[share] = start_group(share);

@@ -37,7 +37,7 @@ World::World(const PhysicsParams& params, const Kernels& kernels, int threads, s
 
 void World::resize(std::uint32_t n) {
   n_ = n;
-  for (auto* v : {&pos_, &vel_, &vel_half_, &pos_next_, &vel_half_next_, &acc_, &pos_at_build_})
+  for (auto* v : {&pos_, &vel_, &vel_half_, &vel_half_before_, &pos_next_, &vel_half_next_, &acc_, &pos_at_build_})
     v->resize(n + kGhostSlots);
   kind_.resize(n);
   id_.resize(n);
@@ -48,7 +48,7 @@ void World::resize(std::uint32_t n) {
 void World::set_ghost() {
   for (std::uint32_t g = n_; g < n_ + kGhostSlots; ++g) {
     pos_[g] = pos_next_[g] = pos_at_build_[g] = kGhostPos;
-    vel_[g] = vel_half_[g] = vel_half_next_[g] = kGhostVel;
+    vel_[g] = vel_half_[g] = vel_half_before_[g] = vel_half_next_[g] = kGhostVel;
     acc_[g] = Float4{};
   }
 }

@@ -11,6 +11,7 @@
 //
 //   spawn round (every kSpawnInterval steps while balls are queued)
 //   swap           the last pass's pos_next, vel_half_next become pos, vel_half
+//                  (and vel_half becomes vel_half_before)
 //   players move   (serial, few)
 //   rebuild?       if a ball strayed > skin/2 and the lists miss one of its
 //                  contacts (or checking costs more): sort by cell, reorder, new lists
@@ -191,7 +192,7 @@ class World {
   std::uint32_t n_ = 0;
   // n_ balls, then kGhostSlots ghosts far away (index n_ pads neighbour lists).
   // The half-step rows' w is 1 / mass (StepArrays::vel_half), vel_'s the mass.
-  AlignedVector<Float4> pos_, vel_half_;
+  AlignedVector<Float4> pos_, vel_half_, vel_half_before_;
   AlignedVector<Float4> pos_next_, vel_half_next_;  // written by the step pass
   // The full-step velocity at time(), stale after a pass until derive_velocities().
   mutable AlignedVector<Float4> vel_;

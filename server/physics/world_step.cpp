@@ -17,8 +17,10 @@ Float4 half_step_row(const Float4& vel) { return {vel.x, vel.y, vel.z, 1.0f / ve
 }  // namespace
 
 float World::kick_drift(std::uint32_t i, const Float4& a) {
-  const float d2 = fishtank::kick_drift(model_, half_step_row(vel_[i]), pos_[i], a, pos_at_build_[i], vel_half_next_[i],
-                                        pos_next_[i]);
+  const Float4 v = half_step_row(vel_[i]);
+  const float d2 = fishtank::kick_drift(model_, v, pos_[i], a, pos_at_build_[i], vel_half_next_[i], pos_next_[i]);
+  // Half a step before v, by the same a: what the step after next reads as the velocity a step earlier.
+  vel_half_[i] = {v.x - a.x * model_.half_dt, v.y - a.y * model_.half_dt, v.z - a.z * model_.half_dt, v.w};
   fastest_next_ = std::max(fastest_next_, std::sqrt(squared_length3(vel_half_next_[i])));
   return d2;
 }
@@ -36,6 +38,7 @@ void World::start_from_current_state() {
   if (needs_rebuild_) rebuild();
   PhaseTimer timer(phase_seconds_.step_pass);
   std::transform(vel_.begin(), vel_.end(), vel_half_.begin(), half_step_row);
+  std::copy(vel_half_.begin(), vel_half_.end(), vel_half_before_.begin());  // no last acceleration known
   float fastest = 0.0f;
   for (std::uint32_t i = 0; i < n_; ++i) fastest = std::max(fastest, std::sqrt(squared_length3(vel_[i])));
   bound_lead(fastest);
@@ -52,8 +55,9 @@ void World::step() {
   if (spawner_.pending() > 0 && steps_ % kSpawnInterval == 0) spawn();
   if (needs_initial_forces_) start_from_current_state();
 
-  // The previous pass's outputs become this step's state.
+  // The previous pass's outputs become this step's state; the half-step velocities rotate.
   pos_.swap(pos_next_);
+  vel_half_before_.swap(vel_half_);
   vel_half_.swap(vel_half_next_);
   move_players();
   if (needs_rebuild_ || !lists_hold()) rebuild();
@@ -144,6 +148,11 @@ void World::sort_and_reorder() {
   vel_.swap(acc_);
   kind_.swap(kind_scratch_);
   id_.swap(id_scratch_);
+  // The old order's vel_half is free now: it takes vel_half_before's new order.
+  pool_.run(n_, [this](std::uint32_t begin, std::uint32_t end, int) {
+    for (std::uint32_t k = begin; k < end; ++k) vel_half_next_[k] = vel_half_before_[order_[k]];
+  });
+  vel_half_before_.swap(vel_half_next_);
   set_ghost();  // the swapped-in buffers' tails
 }
 
@@ -170,6 +179,7 @@ StepContext World::context() {
   StepArrays& s = ctx.arrays;
   s.pos = pos_.data();
   s.vel_half = vel_half_.data();
+  s.vel_half_before = vel_half_before_.data();
   s.pos_next = pos_next_.data();
   s.vel_half_next = vel_half_next_.data();
   s.lists = list_.step_lists(pos_at_build_.data());

@@ -52,7 +52,7 @@ std::uint64_t run(const Kernels& kernels, int threads, std::function<void(int)> 
 // The scalar twin's state after run(): plain IEEE float arithmetic, with no
 // estimate and no fused multiply-add, is the same on every x86-64 processor.
 // Only a change meant to change results may change it.
-constexpr std::uint64_t kScalarStateHash = 0xf6bcba5dded7fa6cull;
+constexpr std::uint64_t kScalarStateHash = 0xf373788e56a9cf06ull;
 
 TEST_CASE("state is bit-identical for 1, 2 and 4 threads", "[physics][determinism]") {
   Kernels threaded_scalar = kScalarKernels;  // the product steps the scalar twin on one thread
@@ -149,7 +149,7 @@ namespace {
 struct DenseScene {
   ContactModel model;
   TankBounds tank;
-  AlignedVector<Float4> pos, vel_half;
+  AlignedVector<Float4> pos, vel_half, vel_half_before;
   NeighbourList list;
   std::uint32_t n;
 
@@ -173,6 +173,11 @@ struct DenseScene {
     pos = unsorted;
     vel_half = unsorted_vel;
     for (std::uint32_t k = 0; k < n; ++k) pos[k] = unsorted[order[k]], vel_half[k] = unsorted_vel[order[k]];
+    // Last accelerations of either sign, which contacts that start or end read.
+    vel_half_before = vel_half;
+    for (std::uint32_t k = 0; k < n; ++k)
+      for (float* v : {&vel_half_before[k].x, &vel_half_before[k].y, &vel_half_before[k].z})
+        *v -= 50.0f * speed(rng) * model.dt;
     list.reserve(n, 64, kernels.list_lanes);
     REQUIRE(kernels.build_lists(list.build_view(pos.data(), n), 0, n) <= list.stride());
     const std::uint32_t listed = std::accumulate(list.counts(), list.counts() + n, 0u);
@@ -188,6 +193,7 @@ struct DenseScene {
     StepArrays& s = ctx.arrays;
     s.pos = pos.data();
     s.vel_half = vel_half.data();
+    s.vel_half_before = vel_half_before.data();
     s.pos_next = pos_next.data();
     s.vel_half_next = vel_half_next.data();
     s.lists = layout;

@@ -32,28 +32,39 @@ TEST_CASE("a settled pile's floor contacts carry its weight on k x, within 0.5 %
   CHECK(floor / weight == Approx(1.0).margin(0.005));
 }
 
-// Over 300 s at the default 13 steps per contact the gas gains about 1e-4 per 100 s
-// (docs/accuracy.md); the drift falls with the step, and at 20 steps it is within 2e-4.
-TEST_CASE("an elastic gas of 1000 balls keeps its energy over 300 s: within 5e-4 by default, 2e-4 at 20 steps",
+// The gas's energy only wanders: a least-squares line through its 300 samples
+// rises less than 1.5e-4 over them. While the window left the other contacts out
+// (contact_law.h) every elastic collision of three balls gained energy and the
+// line rose about 2.7e-4. E0 is read as the last ball is poured, when none
+// touches; the 300 s start 20 s later, once the poured layer has struck the
+// floor: while some 80 balls touch at once, k x^2 / 2 + m v^2 / 2 misreads the
+// energy mid-contact by up to 2e-4, which recovers as they part. The scalar
+// twin steps the same trajectory on every x86-64 processor (determinism_test.cpp),
+// so the margins here are the same on every machine.
+TEST_CASE("an elastic gas of 1000 balls keeps its energy over 300 s within 2e-4, with no upward drift",
           "[physics][energy]") {
-  const auto [steps_per_contact, bound] = GENERATE(table<int, double>({{0, 5e-4}, {20, 2e-4}}));
+  const int steps_per_contact = GENERATE(0, 20);
   PhysicsParams params;
   params.restitution = 1.0f;
   params.gravity = 0.0f;
   params.steps_per_contact = steps_per_contact;
-  World world(params, kSseKernels, 1, 7);
+  World world(params, kScalarKernels, 1, 7);
   world.add_balls(1000);
   while (world.pending() > 0) world.step();  // every ball poured in, moving at its spawn speed
   const auto energy = [&] { return kinetic_energy(world) + elastic_energy(world); };
   const double e0 = energy();
-  double worst = 0.0, at_100 = 0.0;
-  const double start = world.time();
-  for (int second = 1; second <= 300; ++second) {
+  constexpr int kSeconds = 300;
+  double worst = 0.0, sum_t = 0.0, sum_e = 0.0, sum_tt = 0.0, sum_te = 0.0;
+  const double start = world.time() + 20.0;
+  for (int second = 1; second <= kSeconds; ++second) {
     while (world.time() < start + second) world.step();
     const double relative = (energy() - e0) / e0;
     worst = std::max(worst, std::fabs(relative));
-    if (second == 100) at_100 = relative;
+    sum_t += second, sum_e += relative, sum_tt += double(second) * second, sum_te += second * relative;
   }
-  INFO(steps_per_contact << " steps per contact: worst |E - E0| / E0 " << worst << ", " << at_100 << " at 100 s");
-  CHECK(worst <= bound);
+  const double rise = (kSeconds * sum_te - sum_t * sum_e) / (kSeconds * sum_tt - sum_t * sum_t) * kSeconds;
+  INFO(steps_per_contact << " steps per contact (0: default): worst |E - E0| / E0 " << worst << ", the line rises "
+                         << rise << " over " << kSeconds << " s");
+  CHECK(worst <= 2e-4);
+  CHECK(rise <= 1.5e-4);
 }
