@@ -562,6 +562,9 @@ template <class V, class PerGroup>
     neighbour_forces<true>(ctx, block, group_blocks[share], balls[share], f[0], f[1], f[2], share, deferred);
     block += std::size_t(group_blocks[share]) * kCount;
   }
+  // Their neighbours' velocities a step earlier are in no other row read: asked for all at once.
+  for (const WholeLawBlock* b = whole_law.data(); b < deferred; ++b)
+    for (std::uint32_t l = 0; l < kCount; ++l) __builtin_prefetch(&listed(s.vel_half_before, b->block[l]));
   for (const WholeLawBlock* b = whole_law.data(); b < deferred; ++b)
     whole_law_forces(ctx, b->block, balls[b->share], force[b->share]);
   for (std::uint32_t share = 0; share < groups; ++share) {
