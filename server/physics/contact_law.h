@@ -35,9 +35,10 @@
 // which leaves each collision's restitution second order in dt.
 //
 // x is the overlap (negative: the gap), v_n the rate at which the gap opens,
-// inv_m_sum the pair's 1 / m_eff (a wall or a player adds 0), last_accel the
-// rate's change per second over the last step (the pair's relative acceleration
-// along the normal, from StepArrays::vel_half_before).
+// inv_m_sum the pair's 1 / m_eff (a wall or a player adds 0), v_before the
+// rate a step earlier (from StepArrays::vel_half_before; the scalar law asks
+// for it only where a contact starts or ends): (v_n - v_before) / dt is the
+// pair's relative acceleration over the last step.
 
 #include <algorithm>
 #include <cmath>
@@ -93,13 +94,15 @@ inline float lone_pair_force(const ContactModel& m, float overlap, float v_n, fl
   return law_in_window(m, part, v_n, c, inv_m_sum);
 }
 
-inline float normal_force(const ContactModel& m, float overlap, float v_n, float c, float inv_m_sum, float last_accel) {
+template <class RateBefore>
+inline float normal_force(const ContactModel& m, float overlap, float v_n, float c, float inv_m_sum,
+                          RateBefore v_before) {
   WindowContact part = window_contact(overlap, std::fabs(v_n) * m.half_dt);
   if (part.fraction > 0.0f && part.fraction < 1.0f) {
-    // A step before, the overlap was x + v_n dt and the rate v_n - last_accel dt (the drift and kick undone).
-    const float then = overlap + v_n * m.dt, v_then = v_n - last_accel * m.dt;
+    // A step before, the overlap was x + v_n dt (the drift undone) and the rate v_before.
+    const float then = overlap + v_n * m.dt, v_then = v_before();
     const float own = may_touch(m, then, v_then) ? lone_pair_force(m, then, v_then, c, inv_m_sum) * inv_m_sum : 0.0f;
-    part = partial_window(m, overlap, v_n, inv_m_sum, last_accel - own);
+    part = partial_window(m, overlap, v_n, inv_m_sum, (v_n - v_then) * (1.0f / m.dt) - own);
   }
   return law_in_window(m, part, v_n, c, inv_m_sum);
 }
@@ -181,11 +184,13 @@ template <class V>
 }
 
 template <class V>
-[[gnu::always_inline]] inline V normal_force(const ContactModel& m, V overlap, V v_n, V c, V inv_m_sum, V last_accel) {
+[[gnu::always_inline]] inline V normal_force(const ContactModel& m, V overlap, V v_n, V c, V inv_m_sum, V v_before) {
   const V damping = whole_step_damping(m, c, inv_m_sum);
-  const V then = overlap + v_n * V::splat(m.dt), v_then = v_n - last_accel * V::splat(m.dt);
-  const V own = lone_pair_force(m, then, v_then, c, inv_m_sum, damping) * inv_m_sum;  // 0 where the pair did not touch
-  const WindowContactV<V> mid = partial_window(m, overlap, v_n, inv_m_sum, last_accel - own);
+  const V then = overlap + v_n * V::splat(m.dt);
+  const V own =
+      lone_pair_force(m, then, v_before, c, inv_m_sum, damping) * inv_m_sum;  // 0 where the pair did not touch
+  const WindowContactV<V> mid =
+      partial_window(m, overlap, v_n, inv_m_sum, (v_n - v_before) * V::splat(1.0f / m.dt) - own);
   return select(starting_or_ending(m, overlap, v_n), law_in_window(m, mid, v_n, c, inv_m_sum),
                 whole_or_no_contact_force(m, overlap, v_n, damping));
 }

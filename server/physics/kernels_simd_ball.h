@@ -275,13 +275,12 @@ template <class V>
   return {dx, dy, dz, inv_dist, reach - d2 * inv_dist, mul_add(dvz, dz, mul_add(dvy, dy, dvx * dx)) * inv_dist, inv_mj};
 }
 
-// Each lane's pair's last relative acceleration along the normal: the change of its rate over the last step.
+// Each lane's pair's rate a step earlier, along today's normal.
 template <class V>
-[[gnu::always_inline]] inline V pair_last_accel(const StepArrays& s, const ContactModel& m, const std::uint32_t* block,
-                                                const GroupBalls<V>& i, const BlockPairs<V>& p) {
+[[gnu::always_inline]] inline V pair_rate_before(const StepArrays& s, const std::uint32_t* block,
+                                                 const GroupBalls<V>& i, const BlockPairs<V>& p) {
   const VelocityBefore<V> bi = velocity_before<V>(s, i.at), bj = velocity_before<V>(s, block);
-  const V v_n_before = mul_add(bj.z - bi.z, p.dz, mul_add(bj.y - bi.y, p.dy, (bj.x - bi.x) * p.dx)) * p.inv_dist;
-  return (p.v_n - v_n_before) * V::splat(1.0f / m.dt);
+  return mul_add(bj.z - bi.z, p.dz, mul_add(bj.y - bi.y, p.dy, (bj.x - bi.x) * p.dx)) * p.inv_dist;
 }
 
 // c of each lane's pair with its neighbour of 1 / mass inv_mj.
@@ -358,9 +357,9 @@ template <class V>
   const V reach = rj + i.r, reach_lead = reach + V::splat(m.lead_bound);
   const BlockPairs<V> p = block_pairs(s, block, i, dx, dy, dz, d2, reach);
   const auto lanes = (d2 < reach_lead * reach_lead) & starting_or_ending(m, p.overlap, p.v_n);
-  const V last_accel = pair_last_accel(s, m, block, i, p);
+  const V v_before = pair_rate_before(s, block, i, p);
   const V f_over_dist =
-      keep(lanes, normal_force(m, p.overlap, p.v_n, pair_c(i, p.inv_mj), i.inv_m + p.inv_mj, last_accel)) * p.inv_dist;
+      keep(lanes, normal_force(m, p.overlap, p.v_n, pair_c(i, p.inv_mj), i.inv_m + p.inv_mj, v_before)) * p.inv_dist;
   f[0] = neg_mul_add(f_over_dist, dx, f[0]);
   f[1] = neg_mul_add(f_over_dist, dy, f[1]);
   f[2] = neg_mul_add(f_over_dist, dz, f[2]);
@@ -380,8 +379,8 @@ template <class V, class Before>
   const V overlap = select(lower, below, above), v_n = select(lower, v, V::zero() - v);
   V f;
   if (simd::any(starting_or_ending(m, overlap, v_n))) {
-    const V a = (v - before()) * V::splat(1.0f / m.dt);  // the last step's acceleration along the axis
-    f = normal_force(m, overlap, v_n, c, inv_m, select(lower, a, V::zero() - a));
+    const V b = before();
+    f = normal_force(m, overlap, v_n, c, inv_m, select(lower, b, V::zero() - b));
   } else {
     f = whole_or_no_contact_force(m, overlap, v_n, damping);
   }
@@ -417,8 +416,8 @@ template <class V>
       const VelocityBefore<V> b = velocity_before<V>(s, i.at);
       const V v_n_before =
           ((V::splat(vj.x) - b.x) * dx + (V::splat(vj.y) - b.y) * dy + (V::splat(vj.z) - b.z) * dz) * inv_dist;
-      const V a_n = (v_n - v_n_before) * V::splat(1.0f / m.dt);
-      const V f_over_dist = keep(near, normal_force(m, r + V::splat(pj.w) - dist, v_n, c, i.inv_m, a_n) * inv_dist);
+      const V f_over_dist =
+          keep(near, normal_force(m, r + V::splat(pj.w) - dist, v_n, c, i.inv_m, v_n_before) * inv_dist);
       fx = neg_mul_add(f_over_dist, dx, fx);
       fy = neg_mul_add(f_over_dist, dy, fy);
       fz = neg_mul_add(f_over_dist, dz, fz);
