@@ -12,7 +12,7 @@ namespace {
 
 // Walls are half-spaces: the force keeps growing however deep the ball is.
 // A wall is kinematic, so the pair's inverse mass is the ball's.
-// before: the ball's velocity along the axis a step earlier.
+// before: the ball's velocity along the axis a step earlier, read only where a contact starts or ends.
 inline float wall_force_1d(const ContactModel& m, float pos, float vel, const float& before, float r, float inv_mass,
                            float c, float lo, float hi) {
   float f = 0.0f;
