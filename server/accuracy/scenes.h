@@ -2,8 +2,9 @@
 // Scenes with known answers (SPEC 7.1), each run by the product's World or by
 // one of the 1-D schemes of contact_1d.h at a given dt, returning one error:
 //
-//   drop             ball (d = 1) dropped from 1 unit onto the floor: worst error of
-//                    the first three apex heights against exact_apexes, / h0
+//   drop             ball (d = 1) dropped from about 1 unit onto the floor: worst error
+//                    of the first three apex heights against exact_apexes, / h0, over
+//                    kDropPhases heights (where in a step the first contact starts)
 //   head-on          two balls meeting at 2 m/s, no gravity, every size pair: worst
 //                    error of the rebound velocities against exact_rebound, / 2 m/s
 //   head-on-elastic  the same with e = 1 (no dashpot)
@@ -58,6 +59,8 @@ inline constexpr int kHeadOnPhases = 8;
 // The drop scene's constants and the apexes a run measures.
 inline constexpr double kDropHeight = 1.0;
 inline constexpr int kDropBounces = 3;
-std::vector<double> measured_apexes(const Method& method, const SceneConfig& config, double dt);
+inline constexpr int kDropPhases = 8;  // heights the drop's error is the worst of
+std::vector<double> measured_apexes(const Method& method, const SceneConfig& config, double dt,
+                                    double height = kDropHeight);
 
 }  // namespace fishtank::accuracy

@@ -25,20 +25,24 @@
 // group of touching balls. The other forces are the pair's relative acceleration
 // over the last step less this contact's own then, which the law recomputes from
 // the overlap and rate of a step before.
-// The dashpot acts over that part, f dt, on the relative speed solved
-// implicitly for this contact alone: beta = c f dt / (2 m_eff) and
-//   F = k mean_overlap - c f / (1 + beta) v_n.
-// The implicit factor touches the dashpot only, so a resting contact (v_n = 0)
-// rests on k x. That is the pair's trapezoid rule on a spring k (1 + beta),
-// whose damping ratio is lower by sqrt(1 + beta); c is raised by the same
-// factor to first order, c + c^2 dt / (4 m_eff) = c + damping_factor^2 dt / 4,
-// which leaves each collision's restitution second order in dt.
+// The dashpot acts over that part, f dt, on the pair's rate at t: the rate
+// v_n at t - dt/2 plus half a step of the spring, of the pair's other forces
+// and of the dashpot itself, solved implicitly for this contact:
+//   F = k mean_overlap - c f / (1 + beta) (v_n + (k mean_overlap / m_eff + other) dt / 2),
+//   beta = c f dt / (2 m_eff).
+// Without the other forces a dashpot in a row of touching balls acts on the
+// wrong rate by O(dt) and the row's collisions are first order; with them,
+// second order. A ball at rest rests on k x: there the spring and the other
+// forces cancel.
+// The other forces are the pair's relative acceleration over the last step
+// less this contact's own force then, which the law recomputes from the
+// overlap and rate of a step before, its dashpot acting on the same other
+// forces (other_forces).
 //
 // x is the overlap (negative: the gap), v_n the rate at which the gap opens,
 // inv_m_sum the pair's 1 / m_eff (a wall or a player adds 0), v_before the
-// rate a step earlier (from StepArrays::vel_half_before; the scalar law asks
-// for it only where a contact starts or ends): (v_n - v_before) / dt is the
-// pair's relative acceleration over the last step.
+// rate a step earlier (from StepArrays::vel_half_before): (v_n - v_before) / dt
+// is the pair's relative acceleration over the last step.
 
 #include <algorithm>
 #include <cmath>
@@ -50,10 +54,8 @@ namespace fishtank {
 // 2 lead below this is no lead: a pair at rest has none, and the fraction then only says touching or not.
 constexpr float kSmallestLead = 1e-20f;
 
-// c for a pair of inverse-mass sum inv_m_sum, raised as the header says.
-inline float contact_damping(const ContactModel& m, float inv_m_sum) {
-  return m.damping_factor / std::sqrt(inv_m_sum) + m.damping_boost;
-}
+// c for a pair of inverse-mass sum inv_m_sum.
+inline float contact_damping(const ContactModel& m, float inv_m_sum) { return m.damping_factor / std::sqrt(inv_m_sum); }
 
 // c / (1 + beta) for a contact over the fraction of the step in which c_f = c f acts.
 inline float whole_step_damping(const ContactModel& m, float c_f, float inv_m_sum) {
@@ -71,6 +73,7 @@ struct WindowContact {
 };
 
 inline WindowContact window_contact(float overlap, float lead) {
+  if (overlap > lead) return {1.0f, overlap};  // the whole window, as below, without a divide
   const float reach_in = overlap + lead;
   const float fraction = std::clamp(reach_in / std::max(lead + lead, kSmallestLead), 0.0f, 1.0f);
   return {fraction, fraction < 1.0f ? 0.5f * reach_in * fraction : overlap};
@@ -83,41 +86,63 @@ inline WindowContact partial_window(const ContactModel& m, float overlap, float 
   return window_contact(overlap, std::fabs(v_mid) * m.half_dt);
 }
 
-inline float law_in_window(const ContactModel& m, WindowContact part, float v_n, float c, float inv_m_sum) {
-  return m.k * part.mean_overlap - whole_step_damping(m, c * part.fraction, inv_m_sum) * v_n;
+// The window a step before, as for a pair alone (the other forces' share of its lead left out).
+inline WindowContact window_before(const ContactModel& m, float then, float v_before, float inv_m_sum) {
+  const WindowContact part = window_contact(then, std::fabs(v_before) * m.half_dt);
+  return part.fraction > 0.0f && part.fraction < 1.0f ? partial_window(m, then, v_before, inv_m_sum, 0.0f) : part;
 }
 
-// The law for a pair alone (no other forces): this contact's own force a step before.
-inline float lone_pair_force(const ContactModel& m, float overlap, float v_n, float c, float inv_m_sum) {
-  WindowContact part = window_contact(overlap, std::fabs(v_n) * m.half_dt);
-  if (part.fraction > 0.0f && part.fraction < 1.0f) part = partial_window(m, overlap, v_n, inv_m_sum, 0.0f);
-  return law_in_window(m, part, v_n, c, inv_m_sum);
+// The other forces on the pair: a step before, at overlap then = x + v_n dt (the drift undone) and rate
+// v_before, the pair's acceleration (v_n - v_before) / dt was this law over that window, times 1 / m_eff,
+// plus the other forces, the dashpot acting on them too. Solved for them, with c_f = c f then,
+//   other = (1 + c_f dt / (2 m_eff)) a_rel - (k mean_overlap - c_f v_before) / m_eff.
+inline float other_forces(const ContactModel& m, WindowContact then, float v_n, float c, float inv_m_sum,
+                          float v_before) {
+  const float c_f = c * then.fraction;
+  const float a_rel = (v_n - v_before) * (1.0f / m.dt);
+  return (1.0f + c_f * m.half_dt * inv_m_sum) * a_rel - (m.k * then.mean_overlap - c_f * v_before) * inv_m_sum;
 }
 
-template <class RateBefore>
-inline float normal_force(const ContactModel& m, float overlap, float v_n, float c, float inv_m_sum,
-                          RateBefore v_before) {
+inline float normal_force(const ContactModel& m, float overlap, float v_n, float c, float inv_m_sum, float v_before) {
   WindowContact part = window_contact(overlap, std::fabs(v_n) * m.half_dt);
-  if (part.fraction > 0.0f && part.fraction < 1.0f) {
-    // A step before, the overlap was x + v_n dt (the drift undone) and the rate v_before.
-    const float then = overlap + v_n * m.dt, v_then = v_before();
-    const float own = may_touch(m, then, v_then) ? lone_pair_force(m, then, v_then, c, inv_m_sum) * inv_m_sum : 0.0f;
-    part = partial_window(m, overlap, v_n, inv_m_sum, (v_n - v_then) * (1.0f / m.dt) - own);
-  }
-  return law_in_window(m, part, v_n, c, inv_m_sum);
+  if (part.fraction <= 0.0f) return 0.0f;
+  const WindowContact then = window_before(m, overlap + v_n * m.dt, v_before, inv_m_sum);
+  const float other = other_forces(m, then, v_n, c, inv_m_sum, v_before);
+  if (part.fraction < 1.0f) part = partial_window(m, overlap, v_n, inv_m_sum, other);
+  const float spring = m.k * part.mean_overlap, pushed = spring * inv_m_sum + other;
+  return spring - whole_step_damping(m, c * part.fraction, inv_m_sum) * (v_n + pushed * m.half_dt);
+}
+
+// Where a contact lasts the whole window now and lasted it a step before, normal_force's arithmetic
+// gathers into F = k x - now v_n - before v_before, the other forces included: with beta = c dt / (2 m_eff)
+// and D = c / (1 + beta), now = D (3 + beta - k dt^2 / m_eff) / 2 and before = D (beta - 1) / 2.
+// The SIMD twin's fast path takes that form.
+struct WholeWindowDamping {
+  float now, before;
+};
+
+inline WholeWindowDamping whole_window_damping(const ContactModel& m, float c, float inv_m_sum) {
+  const float beta = c * m.half_dt * inv_m_sum, damping = whole_step_damping(m, c, inv_m_sum);
+  return {0.5f * damping * (3.0f + beta - m.k * inv_m_sum * m.dt * m.dt), 0.5f * damping * (beta - 1.0f)};
 }
 
 namespace {  // compiled with each SIMD file's flags: internal linkage (kernels_simd_ball.h)
 
 template <class V>
 [[gnu::always_inline]] inline V contact_damping(const ContactModel& m, V inv_m_sum) {
-  return V::splat(m.damping_factor) / sqrt(inv_m_sum) + V::splat(m.damping_boost);
+  return V::splat(m.damping_factor) / sqrt(inv_m_sum);
 }
 
 template <class V>
 [[gnu::always_inline]] inline V whole_step_damping(const ContactModel& m, V c_f, V inv_m_sum) {
   return c_f / (V::splat(1.0f) + c_f * V::splat(m.half_dt) * inv_m_sum);
 }
+
+// A pair's c and its whole_window_damping.
+template <class V>
+struct WholeDashpot {
+  V c, now, before;
+};
 
 template <class V>
 struct WindowContactV {
@@ -141,11 +166,6 @@ template <class V>
   return window_contact(overlap, abs(v_mid) * half_dt);
 }
 
-template <class V>
-[[gnu::always_inline]] inline V law_in_window(const ContactModel& m, WindowContactV<V> part, V v_n, V c, V inv_m_sum) {
-  return V::splat(m.k) * part.mean_overlap - whole_step_damping(m, c * part.fraction, inv_m_sum) * v_n;
-}
-
 // Lanes where the window holds part of the contact.
 template <class V>
 [[gnu::always_inline]] inline auto is_partial(const WindowContactV<V>& part) {
@@ -158,41 +178,53 @@ template <class V>
   return {select(lanes, a.fraction, b.fraction), select(lanes, a.mean_overlap, b.mean_overlap)};
 }
 
-// Lanes that start or end touching within half a step, whose force needs the
-// whole law; every other lane touches all step (overlap >= lead) or not at all.
+template <class V>
+[[gnu::always_inline]] inline WindowContactV<V> window_before(const ContactModel& m, V then, V v_before, V inv_m_sum) {
+  const WindowContactV<V> part = window_contact(then, abs(v_before) * V::splat(m.half_dt));
+  if (!any(is_partial(part))) return part;  // mostly: the contact started or ended a step before in few lanes
+  return select<V>(is_partial(part), partial_window(m, then, v_before, inv_m_sum, V::zero()), part);
+}
+
+template <class V>
+[[gnu::always_inline]] inline V other_forces(const ContactModel& m, WindowContactV<V> then, V v_n, V c, V inv_m_sum,
+                                             V v_before) {
+  const V c_f = c * then.fraction;
+  const V a_rel = (v_n - v_before) * V::splat(1.0f / m.dt);
+  return (V::splat(1.0f) + c_f * V::splat(m.half_dt) * inv_m_sum) * a_rel -
+         (V::splat(m.k) * then.mean_overlap - c_f * v_before) * inv_m_sum;
+}
+
+// Lanes that start or end touching within half a step: every other lane
+// touches all step (overlap >= lead) or not at all.
 template <class V>
 [[gnu::always_inline]] inline auto starting_or_ending(const ContactModel& m, V overlap, V v_n) {
   return abs(overlap) < abs(v_n) * V::splat(m.half_dt);
 }
 
-// Where every lane touches all step or not at all, the law with in_contact 1 or 0:
-// damping is whole_step_damping(c) of each lane's pair.
+// Lanes whose force needs normal_force: their contact starts or ends this step, or touches all step and
+// did not a step before.
 template <class V>
-[[gnu::always_inline]] inline V whole_or_no_contact_force(const ContactModel& m, V overlap, V v_n, V damping) {
-  return keep(overlap > V::zero(), V::splat(m.k) * overlap - damping * v_n);
+[[gnu::always_inline]] inline auto needs_whole_law(const ContactModel& m, V overlap, V v_n, V v_before) {
+  const V then = overlap + v_n * V::splat(m.dt);
+  return starting_or_ending(m, overlap, v_n) | ((overlap > V::zero()) & (then < abs(v_before) * V::splat(m.half_dt)));
 }
 
-// damping: whole_step_damping(c), the pair's damping where its contact lasts the whole window.
+// The law where no lane needs_whole_law: each touches all step, now and a step before, or not at all
+// (whole_window_damping).
 template <class V>
-[[gnu::always_inline]] inline V lone_pair_force(const ContactModel& m, V overlap, V v_n, V c, V inv_m_sum, V damping) {
-  if (any(starting_or_ending(m, overlap, v_n))) {  // rare: the last step's contact started or ended too
-    const WindowContactV<V> part = window_contact(overlap, abs(v_n) * V::splat(m.half_dt));
-    const WindowContactV<V> mid = partial_window(m, overlap, v_n, inv_m_sum, V::zero());
-    return law_in_window(m, select<V>(is_partial(part), mid, part), v_n, c, inv_m_sum);
-  }
-  return whole_or_no_contact_force(m, overlap, v_n, damping);
+[[gnu::always_inline]] inline V whole_or_no_contact_force(const ContactModel& m, V overlap, V v_n, V v_before,
+                                                          const WholeDashpot<V>& d) {
+  return keep(overlap > V::zero(), V::splat(m.k) * overlap - d.now * v_n - d.before * v_before);
 }
 
 template <class V>
 [[gnu::always_inline]] inline V normal_force(const ContactModel& m, V overlap, V v_n, V c, V inv_m_sum, V v_before) {
-  const V damping = whole_step_damping(m, c, inv_m_sum);
-  const V then = overlap + v_n * V::splat(m.dt);
-  const V own =
-      lone_pair_force(m, then, v_before, c, inv_m_sum, damping) * inv_m_sum;  // 0 where the pair did not touch
-  const WindowContactV<V> mid =
-      partial_window(m, overlap, v_n, inv_m_sum, (v_n - v_before) * V::splat(1.0f / m.dt) - own);
-  return select(starting_or_ending(m, overlap, v_n), law_in_window(m, mid, v_n, c, inv_m_sum),
-                whole_or_no_contact_force(m, overlap, v_n, damping));
+  const WindowContactV<V> then = window_before(m, overlap + v_n * V::splat(m.dt), v_before, inv_m_sum);
+  const V other = other_forces(m, then, v_n, c, inv_m_sum, v_before);
+  WindowContactV<V> part = window_contact(overlap, abs(v_n) * V::splat(m.half_dt));
+  part = select<V>(is_partial(part), partial_window(m, overlap, v_n, inv_m_sum, other), part);
+  const V spring = V::splat(m.k) * part.mean_overlap, pushed = spring * inv_m_sum + other;
+  return spring - whole_step_damping(m, c * part.fraction, inv_m_sum) * (v_n + pushed * V::splat(m.half_dt));
 }
 
 }  // namespace

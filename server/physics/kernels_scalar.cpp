@@ -12,21 +12,19 @@ namespace {
 
 // Walls are half-spaces: the force keeps growing however deep the ball is.
 // A wall is kinematic, so the pair's inverse mass is the ball's.
-// before: the ball's velocity along the axis a step earlier, read only where a contact starts or ends.
-inline float wall_force_1d(const ContactModel& m, float pos, float vel, const float& before, float r, float inv_mass,
-                           float c, float lo, float hi) {
+// before: the ball's velocity along the axis a step earlier.
+inline float wall_force_1d(const ContactModel& m, float pos, float vel, float before, float r, float inv_mass, float c,
+                           float lo, float hi) {
   float f = 0.0f;
   const float below = lo + r - pos, above = pos + r - hi;
-  if (may_touch(m, below, vel)) f += normal_force(m, below, vel, c, inv_mass, [&] { return before; });
-  if (may_touch(m, above, -vel)) f -= normal_force(m, above, -vel, c, inv_mass, [&] { return -before; });
+  if (may_touch(m, below, vel)) f += normal_force(m, below, vel, c, inv_mass, before);
+  if (may_touch(m, above, -vel)) f -= normal_force(m, above, -vel, c, inv_mass, -before);
   return f;
 }
 
-// A body's position, half-step velocity and that velocity a step earlier (StepArrays), read only where a
-// contact starts or ends.
+// A body's position, half-step velocity and that velocity a step earlier (StepArrays).
 struct Body {
-  Float4 pos, vel;
-  const Float4* before;
+  Float4 pos, vel, before;
 };
 
 // The contact force on ball i from body j (a ball, or a player sphere with
@@ -42,10 +40,8 @@ inline Float4 contact_force(const ContactModel& m, const Body& i, const Body& j)
   const float inv_dist = 1.0f / dist;
   const float nx = dx * inv_dist, ny = dy * inv_dist, nz = dz * inv_dist;
   const float v_n = (vj.x - vi.x) * nx + (vj.y - vi.y) * ny + (vj.z - vi.z) * nz;
-  const auto v_n_before = [&] {
-    const Float4 &bi = *i.before, &bj = *j.before;
-    return (bj.x - bi.x) * nx + (bj.y - bi.y) * ny + (bj.z - bi.z) * nz;
-  };
+  const Float4 &bi = i.before, &bj = j.before;
+  const float v_n_before = (bj.x - bi.x) * nx + (bj.y - bi.y) * ny + (bj.z - bi.z) * nz;
   const float inv_m_sum = vi.w + vj.w;
   const float f = normal_force(m, reach - dist, v_n, contact_damping(m, inv_m_sum), inv_m_sum, v_n_before);
   return Float4{-f * nx, -f * ny, -f * nz, 0.0f};
@@ -56,10 +52,10 @@ inline Float4 contact_force(const ContactModel& m, const Body& i, const Body& j)
                                                       const std::uint32_t* list) {
   const StepArrays& s = ctx.arrays;
   const ContactModel& m = ctx.model;
-  const Body bi{s.pos[i], s.vel_half[i], &s.vel_half_before[i]};
+  const Body bi{s.pos[i], s.vel_half[i], s.vel_half_before[i]};
   float fx = 0.0f, fy = 0.0f, fz = 0.0f;
   for (std::uint32_t n = 0; n < lists.counts[i]; ++n) {
-    const Body bj{listed(s.pos, list[n]), listed(s.vel_half, list[n]), &listed(s.vel_half_before, list[n])};
+    const Body bj{listed(s.pos, list[n]), listed(s.vel_half, list[n]), listed(s.vel_half_before, list[n])};
     const Float4 f = contact_force(m, bi, bj);
     fx += f.x;
     fy += f.y;
@@ -72,12 +68,12 @@ inline Float4 contact_force(const ContactModel& m, const Body& i, const Body& j)
 [[gnu::always_inline]] inline Float4 acceleration(const StepContext& ctx, std::uint32_t i, const Float4& f) {
   const StepArrays& s = ctx.arrays;
   const ContactModel& m = ctx.model;
-  const Body bi{s.pos[i], s.vel_half[i], &s.vel_half_before[i]};
-  const Float4 &pi = bi.pos, &vi = bi.vel, &before = *bi.before;
+  const Body bi{s.pos[i], s.vel_half[i], s.vel_half_before[i]};
+  const Float4 &pi = bi.pos, &vi = bi.vel, &before = bi.before;
   float fx = f.x, fy = f.y, fz = f.z;
   for (int p = 0; p < s.players; ++p) {
     const Float4& vp = s.player_vel[p];  // kinematic: taken as unaccelerated
-    const Float4 fp = contact_force(m, bi, Body{s.player_pos[p], vp, &vp});
+    const Float4 fp = contact_force(m, bi, Body{s.player_pos[p], vp, vp});
     fx += fp.x;
     fy += fp.y;
     fz += fp.z;

@@ -190,35 +190,56 @@ std::uint32_t build_lists(const ListBuild& b, std::uint32_t begin, std::uint32_t
 template <class V>
 struct Lanes;
 
-// c and c / (1 + beta) (contact_law.h) of each pair of ball kinds, and of each
-// kind against a wall or a player (kinematic: m_eff = m). Made once per batch
-// with the scalar law, the same values each lane would compute: a group then
-// picks its lanes' rows instead of taking square roots and quotients.
+// c and whole_window_damping (contact_law.h) of each pair of ball kinds,
+// and of each kind against a wall or a player (kinematic: m_eff = m). Made
+// once per batch with the scalar law, the same values each lane would compute:
+// a group then picks its lanes' rows instead of taking square roots and quotients.
 struct KindDamping {
-  float c[kKindCount][kKindCount], damping[kKindCount][kKindCount];  // [kind of i][kind of j]
-  float kinematic_c[kKindCount], kinematic_damping[kKindCount];
+  struct Dashpot {
+    float c, now, before;
+  };
+  Dashpot pair[kKindCount][kKindCount];  // [kind of i][kind of j]
+  Dashpot kinematic[kKindCount];
+
+  static Dashpot dashpot(const ContactModel& m, float inv_m_sum) {
+    const float c = contact_damping(m, inv_m_sum);
+    const WholeWindowDamping d = whole_window_damping(m, c, inv_m_sum);
+    return {c, d.now, d.before};
+  }
 
   explicit KindDamping(const ContactModel& m) {
     for (int a = 0; a < kKindCount; ++a) {
       const float inv_m = 1.0f / kBallKinds[a].mass;
-      kinematic_c[a] = contact_damping(m, inv_m);
-      kinematic_damping[a] = whole_step_damping(m, kinematic_c[a], inv_m);
-      for (int b = 0; b < kKindCount; ++b) {
-        const float inv_m_sum = inv_m + 1.0f / kBallKinds[b].mass;
-        c[a][b] = contact_damping(m, inv_m_sum);
-        damping[a][b] = whole_step_damping(m, c[a][b], inv_m_sum);
-      }
+      kinematic[a] = dashpot(m, inv_m);
+      for (int b = 0; b < kKindCount; ++b) pair[a][b] = dashpot(m, inv_m + 1.0f / kBallKinds[b].mass);
     }
   }
 };
 
-// Each lane's entry of a per-kind row; a ball's kind is known by its 1 / mass.
+// Each lane's dashpot from a per-kind row; a ball's kind is known by its 1 / mass.
 template <class V>
-[[gnu::always_inline]] inline V of_lane_kinds(V inv_m, const float (&of_kind)[kKindCount]) {
-  V value = V::splat(of_kind[0]);
-  for (int k = 1; k < kKindCount; ++k)
-    value = select(inv_m == V::splat(1.0f / kBallKinds[k].mass), V::splat(of_kind[k]), value);
-  return value;
+[[gnu::always_inline]] inline WholeDashpot<V> of_lane_kinds(V inv_m,
+                                                            const KindDamping::Dashpot (&of_kind)[kKindCount]) {
+  WholeDashpot<V> d{V::splat(of_kind[0].c), V::splat(of_kind[0].now), V::splat(of_kind[0].before)};
+  for (int k = 1; k < kKindCount; ++k) {
+    const auto lanes = inv_m == V::splat(1.0f / kBallKinds[k].mass);
+    d = {select(lanes, V::splat(of_kind[k].c), d.c), select(lanes, V::splat(of_kind[k].now), d.now),
+         select(lanes, V::splat(of_kind[k].before), d.before)};
+  }
+  return d;
+}
+
+// Of each lane's dashpots with every kind (of_kind, made per group), those with neighbours of 1 / mass inv_mj.
+template <class V>
+[[gnu::always_inline]] inline WholeDashpot<V> of_neighbour_kinds(V inv_mj,
+                                                                 const WholeDashpot<V> (&of_kind)[kKindCount]) {
+  WholeDashpot<V> d = of_kind[0];
+  for (int k = 1; k < kKindCount; ++k) {
+    const auto lanes = inv_mj == V::splat(1.0f / kBallKinds[k].mass);
+    d = {select(lanes, of_kind[k].c, d.c), select(lanes, of_kind[k].now, d.now),
+         select(lanes, of_kind[k].before, d.before)};
+  }
+  return d;
 }
 
 // A group's balls, one per lane.
@@ -227,23 +248,10 @@ struct GroupBalls {
   V x, y, z, r;  // position, radius
   V vx, vy, vz;  // half-step velocity
   V inv_m;       // 1 / mass
+  V bx, by, bz;  // half-step velocity a step earlier (StepArrays::vel_half_before)
   const KindDamping* kinds;
   const std::uint32_t* at;  // their list entries
 };
-
-// Half-step velocities a step earlier (StepArrays::vel_half_before), read only where a contact starts or ends.
-template <class V>
-struct VelocityBefore {
-  V x, y, z;
-};
-
-template <class V>
-[[gnu::always_inline]] inline VelocityBefore<V> velocity_before(const StepArrays& s, const std::uint32_t* at) {
-  VelocityBefore<V> b;
-  V unused;
-  Lanes<V>::load(s.vel_half_before, at, b.x, b.y, b.z, unused);
-  return b;
-}
 
 // Below this lead bound (every ball nearly at rest), contacts that start or end are rare: a branch per block
 // lists them, and each group sums them after its other blocks (neighbour_forces); in a moving pile they are
@@ -279,8 +287,9 @@ template <class V>
 template <class V>
 [[gnu::always_inline]] inline V pair_rate_before(const StepArrays& s, const std::uint32_t* block,
                                                  const GroupBalls<V>& i, const BlockPairs<V>& p) {
-  const VelocityBefore<V> bi = velocity_before<V>(s, i.at), bj = velocity_before<V>(s, block);
-  return mul_add(bj.z - bi.z, p.dz, mul_add(bj.y - bi.y, p.dy, (bj.x - bi.x) * p.dx)) * p.inv_dist;
+  V bx, by, bz, unused;
+  Lanes<V>::load(s.vel_half_before, block, bx, by, bz, unused);
+  return mul_add(bz - i.bz, p.dz, mul_add(by - i.by, p.dy, (bx - i.bx) * p.dx)) * p.inv_dist;
 }
 
 // c of each lane's pair with its neighbour of 1 / mass inv_mj.
@@ -288,14 +297,14 @@ template <class V>
 [[gnu::always_inline]] inline V pair_c(const GroupBalls<V>& i, V inv_mj) {
   V c = V::zero();
   for (int k = 0; k < kKindCount; ++k)  // the tables are symmetric
-    c = select(inv_mj == V::splat(1.0f / kBallKinds[k].mass), of_lane_kinds(i.inv_m, i.kinds->c[k]), c);
+    c = select(inv_mj == V::splat(1.0f / kBallKinds[k].mass), of_lane_kinds(i.inv_m, i.kinds->pair[k]).c, c);
   return c;
 }
 
 // Sum over each lane's neighbours of the contact force, into fx, fy, fz, in
 // list order as in the scalar twin (deferred lanes after the rest). Most
-// contacts last the whole step (or are none): their law is k x - damping v_n,
-// with damping taken by the neighbour's kind from a table made once per group.
+// contacts last the whole step (or are none): their law is whole_or_no_contact_force,
+// with the dashpot taken by the neighbour's kind from a table made once per group.
 // A lane whose contact starts or ends takes the whole law (contact_law.h)
 // later, in whole_law_forces, its block listed at `deferred`, so that this loop
 // stays short. Where a pile moves such blocks are common and a branch per block
@@ -307,9 +316,9 @@ template <bool kBranchFree, class V>
                                                     std::uint32_t share, WholeLawBlock*& deferred) {
   const StepArrays& s = ctx.arrays;
   const ContactModel& m = ctx.model;
-  // A neighbour's kind is known by its 1 / mass: c / (1 + beta) of each lane's pair with each kind.
-  V kind_damping[kKindCount];
-  for (int k = 0; k < kKindCount; ++k) kind_damping[k] = of_lane_kinds(i.inv_m, i.kinds->damping[k]);
+  // A neighbour's kind is known by its 1 / mass: the dashpot of each lane's pair with each kind.
+  WholeDashpot<V> kind_dashpot[kKindCount];
+  for (int k = 0; k < kKindCount; ++k) kind_dashpot[k] = of_lane_kinds(i.inv_m, i.kinds->pair[k]);
   const V lead_bound = V::splat(m.lead_bound);
   fx = fy = fz = V::zero();
   // Past its end, a shorter list's lane holds the ghost: it touches nothing.
@@ -324,11 +333,9 @@ template <bool kBranchFree, class V>
     if (!simd::any(near)) continue;
     const BlockPairs<V> p = block_pairs(s, block, i, dx, dy, dz, d2, reach);
     // Lanes that are not near cannot start within the step (lead_bound bounds every lead).
-    const auto whole_law = starting_or_ending(m, p.overlap, p.v_n);
-    V damping = kind_damping[0];
-    for (int k = 1; k < kKindCount; ++k)
-      damping = select(p.inv_mj == V::splat(1.0f / kBallKinds[k].mass), kind_damping[k], damping);
-    V f = whole_or_no_contact_force(m, p.overlap, p.v_n, damping);
+    const V v_before = pair_rate_before(s, block, i, p);
+    const auto whole_law = needs_whole_law(m, p.overlap, p.v_n, v_before);
+    V f = whole_or_no_contact_force(m, p.overlap, p.v_n, v_before, of_neighbour_kinds(p.inv_mj, kind_dashpot));
     if constexpr (kBranchFree) {  // those lanes' force comes from whole_law_forces
       f = select(whole_law, V::zero(), f);
       *deferred = {block, share};
@@ -356,8 +363,8 @@ template <class V>
   const V d2 = mul_add(dz, dz, mul_add(dy, dy, dx * dx));
   const V reach = rj + i.r, reach_lead = reach + V::splat(m.lead_bound);
   const BlockPairs<V> p = block_pairs(s, block, i, dx, dy, dz, d2, reach);
-  const auto lanes = (d2 < reach_lead * reach_lead) & starting_or_ending(m, p.overlap, p.v_n);
   const V v_before = pair_rate_before(s, block, i, p);
+  const auto lanes = (d2 < reach_lead * reach_lead) & needs_whole_law(m, p.overlap, p.v_n, v_before);
   const V f_over_dist =
       keep(lanes, normal_force(m, p.overlap, p.v_n, pair_c(i, p.inv_mj), i.inv_m + p.inv_mj, v_before)) * p.inv_dist;
   f[0] = neg_mul_add(f_over_dist, dx, f[0]);
@@ -369,21 +376,18 @@ template <class V>
 // points +axis, above the maximum face -axis; both grow with depth. A ball
 // reaches one face of an axis at most, so the law runs once, on the nearer
 // face (the other's force is zero); where no lane's contact starts or ends
-// there, it is k x - damping v_n with the group's damping (contact_law.h).
-// before() reads the lanes' velocity along the axis a step earlier, wanted only where a contact starts or ends.
-template <class V, class Before>
-[[gnu::always_inline]] inline V wall_force(const ContactModel& m, V c, V damping, V inv_m, V p, V v, Before before, V r,
-                                           float lo, float hi) {
+// there, it is whole_or_no_contact_force with the group's dashpot d (contact_law.h).
+// before: the lanes' velocity along the axis a step earlier.
+template <class V>
+[[gnu::always_inline]] inline V wall_force(const ContactModel& m, const WholeDashpot<V>& d, V inv_m, V p, V v, V before,
+                                           V r, float lo, float hi) {
   const V below = V::splat(lo) + r - p, above = p + r - V::splat(hi);
   const auto lower = below > above;
   const V overlap = select(lower, below, above), v_n = select(lower, v, V::zero() - v);
-  V f;
-  if (simd::any(starting_or_ending(m, overlap, v_n))) {
-    const V b = before();
-    f = normal_force(m, overlap, v_n, c, inv_m, select(lower, b, V::zero() - b));
-  } else {
-    f = whole_or_no_contact_force(m, overlap, v_n, damping);
-  }
+  const V v_before = select(lower, before, V::zero() - before);
+  const V f = simd::any(needs_whole_law(m, overlap, v_n, v_before))
+                  ? normal_force(m, overlap, v_n, d.c, inv_m, v_before)
+                  : whole_or_no_contact_force(m, overlap, v_n, v_before, d);
   return select(lower, f, V::zero() - f);
 }
 
@@ -400,7 +404,7 @@ template <class V>
   const auto near_z = (V::splat(t.min.z) + reach > i.z) | (i.z + reach > V::splat(t.max.z));
   const bool walls = simd::any(near_x | near_y | near_z);  // most groups touch no wall
   if (walls || s.players > 0) {
-    const V c = of_lane_kinds(i.inv_m, i.kinds->kinematic_c);
+    const WholeDashpot<V> d = of_lane_kinds(i.inv_m, i.kinds->kinematic);
     for (int p = 0; p < s.players; ++p) {
       const Float4 pj = s.player_pos[p], vj = s.player_vel[p];
       const V dx = V::splat(pj.x) - i.x, dy = V::splat(pj.y) - i.y, dz = V::splat(pj.z) - i.z;
@@ -413,23 +417,18 @@ template <class V>
       const V v_n =
           ((V::splat(vj.x) - i.vx) * dx + (V::splat(vj.y) - i.vy) * dy + (V::splat(vj.z) - i.vz) * dz) * inv_dist;
       // The sphere is kinematic, taken as unaccelerated: the pair's rate changed with the ball's velocity.
-      const VelocityBefore<V> b = velocity_before<V>(s, i.at);
       const V v_n_before =
-          ((V::splat(vj.x) - b.x) * dx + (V::splat(vj.y) - b.y) * dy + (V::splat(vj.z) - b.z) * dz) * inv_dist;
+          ((V::splat(vj.x) - i.bx) * dx + (V::splat(vj.y) - i.by) * dy + (V::splat(vj.z) - i.bz) * dz) * inv_dist;
       const V f_over_dist =
-          keep(near, normal_force(m, r + V::splat(pj.w) - dist, v_n, c, i.inv_m, v_n_before) * inv_dist);
+          keep(near, normal_force(m, r + V::splat(pj.w) - dist, v_n, d.c, i.inv_m, v_n_before) * inv_dist);
       fx = neg_mul_add(f_over_dist, dx, fx);
       fy = neg_mul_add(f_over_dist, dy, fy);
       fz = neg_mul_add(f_over_dist, dz, fz);
     }
     if (walls) {  // an axis no lane is near adds zero
-      const V damping = of_lane_kinds(i.inv_m, i.kinds->kinematic_damping);
-      const auto x_before = [&] { return velocity_before<V>(s, i.at).x; };
-      const auto y_before = [&] { return velocity_before<V>(s, i.at).y; };
-      const auto z_before = [&] { return velocity_before<V>(s, i.at).z; };
-      if (simd::any(near_x)) fx += wall_force(m, c, damping, i.inv_m, i.x, i.vx, x_before, r, t.min.x, t.max.x);
-      if (simd::any(near_y)) fy += wall_force(m, c, damping, i.inv_m, i.y, i.vy, y_before, r, t.min.y, t.max.y);
-      if (simd::any(near_z)) fz += wall_force(m, c, damping, i.inv_m, i.z, i.vz, z_before, r, t.min.z, t.max.z);
+      if (simd::any(near_x)) fx += wall_force(m, d, i.inv_m, i.x, i.vx, i.bx, r, t.min.x, t.max.x);
+      if (simd::any(near_y)) fy += wall_force(m, d, i.inv_m, i.y, i.vy, i.by, r, t.min.y, t.max.y);
+      if (simd::any(near_z)) fz += wall_force(m, d, i.inv_m, i.z, i.vz, i.bz, r, t.min.z, t.max.z);
     }
   }
   fx = fx * i.inv_m;
@@ -464,6 +463,7 @@ template <std::uint32_t kCount>
   for (std::size_t line = rows; line < rows + kCount * sizeof(Float4); line += kCacheLine) {
     prefetch<Reuse::kAgain>(s.pos, line);
     prefetch<Reuse::kAgain>(s.vel_half, line);
+    prefetch<Reuse::kAgain>(s.vel_half_before, line);
     prefetch<Reuse::kOnce>(lists.records, line);  // 16 bytes per ball too, in the batch's group order
     prefetch<Reuse::kOnce>(s.pos_next, line);
     prefetch<Reuse::kOnce>(s.vel_half_next, line);
@@ -478,6 +478,7 @@ template <std::uint32_t kCount>
   for (std::uint32_t k = share; k < remote.count; k += kStepBatch / kCount) {
     prefetch<Reuse::kAgain>(s.pos, std::size_t(remote.rows[k]) * sizeof(Float4));
     prefetch<Reuse::kAgain>(s.vel_half, std::size_t(remote.rows[k]) * sizeof(Float4));
+    prefetch<Reuse::kAgain>(s.vel_half_before, std::size_t(remote.rows[k]) * sizeof(Float4));
   }
 }
 
@@ -498,6 +499,7 @@ template <std::uint32_t kCount>
   for (std::size_t line = from; line < std::min(end_line, from + per_group); ++line) {
     prefetch<Reuse::kAgain>(s.pos, line * kCacheLine);
     prefetch<Reuse::kAgain>(s.vel_half, line * kCacheLine);
+    prefetch<Reuse::kAgain>(s.vel_half_before, line * kCacheLine);
   }
 }
 
@@ -534,6 +536,8 @@ template <class V, class PerGroup>
     i.at = at;
     Lanes<V>::load(s.pos, at, i.x, i.y, i.z, i.r);
     Lanes<V>::load(s.vel_half, at, i.vx, i.vy, i.vz, i.inv_m);
+    V unused;
+    Lanes<V>::load(s.vel_half_before, at, i.bx, i.by, i.bz, unused);
     return i;
   };
   if (m.lead_bound < kStillLead) {  // each group in turn, its blocks in which a contact starts or ends after the rest
@@ -561,9 +565,6 @@ template <class V, class PerGroup>
     neighbour_forces<true>(ctx, block, group_blocks[share], balls[share], f[0], f[1], f[2], share, deferred);
     block += std::size_t(group_blocks[share]) * kCount;
   }
-  // Their neighbours' velocities a step earlier are in no other row read: asked for all at once.
-  for (const WholeLawBlock* b = whole_law.data(); b < deferred; ++b)
-    for (std::uint32_t l = 0; l < kCount; ++l) __builtin_prefetch(&listed(s.vel_half_before, b->block[l]));
   for (const WholeLawBlock* b = whole_law.data(); b < deferred; ++b)
     whole_law_forces(ctx, b->block, balls[b->share], force[b->share]);
   for (std::uint32_t share = 0; share < groups; ++share) {

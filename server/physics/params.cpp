@@ -79,7 +79,6 @@ ContactModel make_contact_model(const PhysicsParams& p) {
   m.damping_factor = 2.0f * damping_ratio(p.restitution) * std::sqrt(p.stiffness);
   m.dt = derived_dt(p);
   m.half_dt = 0.5f * m.dt;
-  m.damping_boost = 0.25f * m.damping_factor * m.damping_factor * m.dt;
   m.gravity = p.gravity;
   return m;
 }

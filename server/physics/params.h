@@ -48,7 +48,6 @@ struct PhysicsParams {
 struct ContactModel {
   float k;
   float damping_factor;  // 2 zeta sqrt(k): c = damping_factor * sqrt(m_eff)
-  float damping_boost;   // damping_factor^2 dt / 4, added to c (contact_law.h says why)
   float dt;
   float half_dt;
   float gravity;

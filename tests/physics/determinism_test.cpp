@@ -52,7 +52,7 @@ std::uint64_t run(const Kernels& kernels, int threads, std::function<void(int)> 
 // The scalar twin's state after run(): plain IEEE float arithmetic, with no
 // estimate and no fused multiply-add, is the same on every x86-64 processor.
 // Only a change meant to change results may change it.
-constexpr std::uint64_t kScalarStateHash = 0xf373788e56a9cf06ull;
+constexpr std::uint64_t kScalarStateHash = 0xb75f42c62e22001dull;
 
 TEST_CASE("state is bit-identical for 1, 2 and 4 threads", "[physics][determinism]") {
   Kernels threaded_scalar = kScalarKernels;  // the product steps the scalar twin on one thread
