@@ -13,7 +13,8 @@
 //   v    = vel_half + a dt/2                 (the full step, not stored)
 //   vel_half_next = v + a dt/2,  pos_next = pos + vel_half_next dt
 // vel_half_before, the half-step velocity a step earlier (the buffers rotate),
-// gives the last step's acceleration; only contacts that start or end read it.
+// gives the last step's acceleration, from which each contact takes the
+// other forces on its pair (contact_law.h).
 
 #include <cstdint>
 #include <limits>

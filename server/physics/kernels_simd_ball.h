@@ -253,12 +253,12 @@ struct GroupBalls {
   const std::uint32_t* at;  // their list entries
 };
 
-// Below this lead bound (every ball nearly at rest), contacts that start or end are rare: a branch per block
+// Below this lead bound (every ball nearly at rest), lanes that need the whole law are rare: a branch per block
 // lists them, and each group sums them after its other blocks (neighbour_forces); in a moving pile they are
 // common, listed without a branch, and summed once the batch's other blocks are.
 constexpr float kStillLead = 1e-3f;
 
-// A block of a group's lists in which some lane's contact starts or ends.
+// A block of a group's lists in which some lane needs the whole law (needs_whole_law).
 struct WholeLawBlock {
   const std::uint32_t* block;
   std::uint32_t share;  // the group's place in its batch
@@ -305,7 +305,7 @@ template <class V>
 // list order as in the scalar twin (deferred lanes after the rest). Most
 // contacts last the whole step (or are none): their law is whole_or_no_contact_force,
 // with the dashpot taken by the neighbour's kind from a table made once per group.
-// A lane whose contact starts or ends takes the whole law (contact_law.h)
+// A lane whose contact starts or ends, now or a step before, takes the whole law (contact_law.h)
 // later, in whole_law_forces, its block listed at `deferred`, so that this loop
 // stays short. Where a pile moves such blocks are common and a branch per block
 // would be mispredicted often, so they are listed without one (kBranchFree); at
@@ -351,7 +351,7 @@ template <bool kBranchFree, class V>
   }
 }
 
-// The whole law's force on the lanes of one deferred block whose contact starts or ends, added to f.
+// The whole law's force on the lanes of one deferred block that need it, added to f.
 template <class V>
 [[gnu::always_inline]] inline void whole_law_forces(const StepContext& ctx, const std::uint32_t* block,
                                                     const GroupBalls<V>& i, V (&f)[3]) {
@@ -375,7 +375,7 @@ template <class V>
 // One axis of the six half-space walls: below the minimum face the force
 // points +axis, above the maximum face -axis; both grow with depth. A ball
 // reaches one face of an axis at most, so the law runs once, on the nearer
-// face (the other's force is zero); where no lane's contact starts or ends
+// face (the other's force is zero); where no lane needs the whole law
 // there, it is whole_or_no_contact_force with the group's dashpot d (contact_law.h).
 // before: the lanes' velocity along the axis a step earlier.
 template <class V>
@@ -505,7 +505,7 @@ template <std::uint32_t kCount>
 
 // A batch's groups, one ball per lane: a = F / m + g, then per_group(at, i, ax, ay, az, record)
 // does the rest for the balls at list entries `at`. While the balls move (kStillLead), the blocks
-// in which a contact starts or ends are summed after all the batch's others, one branch-free pass
+// that need the whole law are summed after all the batch's others, one branch-free pass
 // listing them: each group's a waits for that.
 template <class V, class PerGroup>
 [[gnu::always_inline]] inline void for_each_group_of_batch(const StepContext& ctx, const GroupLists& lists,
@@ -522,7 +522,7 @@ template <class V, class PerGroup>
   const std::uint32_t batch_number = batch / kStepBatch;
   const bool fetching = in_window(edges.rows[0], batch_number) || in_window(edges.rows[1], batch_number);
   const KindDamping kinds(m);
-  // The blocks in which a contact starts or ends, of a group (at rest) or of the batch (moving).
+  // The blocks that need the whole law, of a group (at rest) or of the batch (moving).
   thread_local std::vector<WholeLawBlock> whole_law;
   whole_law.resize(std::max<std::size_t>(whole_law.size(), std::size_t(groups) * lists.stride + 1));
   // Asks for what later groups need, and loads the group's balls.
@@ -540,7 +540,7 @@ template <class V, class PerGroup>
     Lanes<V>::load(s.vel_half_before, at, i.bx, i.by, i.bz, unused);
     return i;
   };
-  if (m.lead_bound < kStillLead) {  // each group in turn, its blocks in which a contact starts or ends after the rest
+  if (m.lead_bound < kStillLead) {  // each group in turn, its blocks that need the whole law after the rest
     for (std::uint32_t share = 0; share < groups; ++share) {
       GroupBalls<V> i = start_group(share);
       const std::uint32_t* const group_record = record + 4 * kCount * share;
@@ -554,7 +554,7 @@ template <class V, class PerGroup>
     }
     return;
   }
-  // Each group's balls and forces are held while the blocks in which a contact starts or ends are summed.
+  // Each group's balls and forces are held while the blocks that need the whole law are summed.
   constexpr std::uint32_t kGroups = kStepBatch / kCount;
   GroupBalls<V> balls[kGroups];
   V force[kGroups][3];

@@ -1,6 +1,6 @@
 // Two facts of the contact law beyond single collisions (contact_law.h): a
-// pile at rest stands on k x (the dashpot's implicit factor does not soften
-// the spring), and an elastic gas keeps its energy.
+// pile at rest stands on k x (in the dashpot's rate the spring and the other
+// forces cancel), and an elastic gas keeps its energy.
 
 #include <algorithm>
 #include <catch2/catch.hpp>
