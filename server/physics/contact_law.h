@@ -22,9 +22,7 @@
 // mid-window, after the half kick of the spring and of the pair's other forces
 // (other contacts, gravity): start and end then mirror each other, and an
 // elastic contact neither gains nor loses energy on average, alone or in a
-// group of touching balls. The other forces are the pair's relative acceleration
-// over the last step less this contact's own then, which the law recomputes from
-// the overlap and rate of a step before.
+// group of touching balls.
 // The dashpot acts over that part, f dt, on the pair's rate at t: the rate
 // v_n at t - dt/2 plus half a step of the spring, of the pair's other forces
 // and of the dashpot itself, solved implicitly for this contact:
@@ -34,10 +32,10 @@
 // wrong rate by O(dt) and the row's collisions are first order; with them,
 // second order. A ball at rest rests on k x: there the spring and the other
 // forces cancel.
-// The other forces are the pair's relative acceleration over the last step
-// less this contact's own force then, which the law recomputes from the
-// overlap and rate of a step before, its dashpot acting on the same other
-// forces (other_forces).
+// The other forces (other contacts, gravity) are the pair's relative
+// acceleration over the last step less this contact's own force then, which the
+// law recomputes from the overlap and rate of a step before, its dashpot acting
+// on the same other forces (other_forces).
 //
 // x is the overlap (negative: the gap), v_n the rate at which the gap opens,
 // inv_m_sum the pair's 1 / m_eff (a wall or a player adds 0), v_before the
