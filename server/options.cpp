@@ -121,7 +121,8 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "steps-per-contact", po::value(&steps_per_contact)->default_value(steps_per_contact),
       "automatic dt = contact duration / this (>= 10; 0: from --tolerance)")(
       "dt", po::value(&o.physics.dt)->default_value(0.0), "fixed time step in seconds (0: automatic)")(
-      "skin", po::value(&o.physics.skin)->default_value(defaults.skin, "0.2"), "neighbour-list skin, units");
+      "skin", po::value(&o.physics.skin)->default_value(defaults.skin, "0"),
+      "neighbour-list skin, units (0: follows the motion, 0.1-1)");
 
   po::options_description bench("Benchmark");
   bench.add_options()("bench", po::bool_switch(&o.bench), "run unpaced without network and print one JSON object")(

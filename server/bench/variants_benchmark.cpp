@@ -164,7 +164,7 @@ void build_lists(benchmark::State& state, const fishtank::Kernels& kernels) {
   const auto n = static_cast<std::uint32_t>(unsorted.size());
   unsorted.resize(n + fishtank::kGhostSlots, fishtank::kGhostPos);
   fishtank::NeighbourList list;
-  list.configure(params.tank, params.skin);
+  list.configure(params.tank, fishtank::starting_skin(params));
   std::vector<std::uint32_t> order;
   list.sort(unsorted.data(), n, order);
   fishtank::AlignedVector<fishtank::Float4> pos(unsorted);

@@ -73,7 +73,7 @@ std::string write_input(const World& world, const std::string& path, std::uint64
     for (int b = a; b < kKindCount; ++b)
       std::fprintf(f, "pair_coeff %d %d hooke %.9g %.9g tangential linear_nohistory 0.0 0.0 damping velocity\n", a + 1,
                    b + 1, p.stiffness, lammps_damping(world, a, b));
-  std::fprintf(f, "\nneighbor %g bin\nneigh_modify delay 0 every 1 check yes\n\n", p.skin);
+  std::fprintf(f, "\nneighbor %g bin\nneigh_modify delay 0 every 1 check yes\n\n", starting_skin(p));
   std::fprintf(f, "fix integrate all nve/sphere\nfix gravity all gravity %.9g vector 0.0 -1.0 0.0\n", p.gravity);
   const char* axes[3] = {"x", "y", "z"};
   const float lo[3] = {t.min.x, t.min.y, t.min.z}, hi[3] = {t.max.x, t.max.y, t.max.z};

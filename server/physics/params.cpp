@@ -59,8 +59,8 @@ std::string validate(const PhysicsParams& p) {
         << PhysicsParams::kMinStepsPerContact
         << " steps, so dt must be <= " << contact_duration(p.stiffness) / PhysicsParams::kMinStepsPerContact
         << " s (automatic: " << contact_duration(p.stiffness) / static_cast<float>(steps_per_contact(p)) << " s)";
-  else if (!std::isfinite(p.skin) || p.skin <= 0.0f || p.skin > 10.0f)
-    err << "neighbour skin must be in (0, 10] units, got " << p.skin;
+  else if (!std::isfinite(p.skin) || p.skin < 0.0f || p.skin > 10.0f)
+    err << "neighbour skin must be in (0, 10] units, or 0 to follow the motion, got " << p.skin;
   else if (!std::isfinite(p.gravity) || std::fabs(p.gravity) > 1000.0f)
     err << "gravity must be in [-1000, 1000] m/s^2, got " << p.gravity;
   else if (!std::isfinite(p.player_max_speed) || p.player_max_speed < 0.0f || p.player_max_speed > 100.0f)

@@ -33,7 +33,7 @@ struct PhysicsParams {
   float tolerance = 0.005f;        // largest per-collision restitution error: sets n
   int steps_per_contact = 0;       // n in dt = t_c / n; 0: from the tolerance
   float dt = 0.0f;                 // 0: derive from k; otherwise must be <= t_c / kMinStepsPerContact
-  float skin = 0.2f;               // neighbour-list skin, units (report, section 3: how it was chosen)
+  float skin = 0.0f;               // neighbour-list skin, units; 0: follows the motion (World::adapt_skin)
   float gravity = 9.81f;           // m/s^2, along -y
   float player_max_speed = 10.0f;  // m/s; faster commands are clamped
   TankBounds tank;
@@ -42,6 +42,11 @@ struct PhysicsParams {
   static constexpr float kToleranceRule = 0.8f;        // worst error times n^2, at most
   static constexpr float kTightestTolerance = 0.002f;  // float32 positions floor for a 0.1 m/s contact
   static constexpr float kLoosestTolerance = 0.0075f;  // 11 steps: the rule's margin over kMinStepsPerContact
+  // The adaptive skin starts at kStartSkin and stays within [kMinSkin, kMaxSkin] (report 3.3).
+  static constexpr float kStartSkin = 0.2f, kMinSkin = 0.1f, kMaxSkin = 1.0f;
+  // A build's cost per ball over what a unit of skin adds to each ball's step (longer lists), in
+  // units x steps: the skin that minimises their sum is sqrt(2 kSkinCostRatio x the drift per step).
+  static constexpr float kSkinCostRatio = 100.0f;
 };
 
 // Everything the kernels need, derived once from PhysicsParams.
@@ -63,6 +68,7 @@ float contact_duration(float stiffness);
 int steps_for_tolerance(float tolerance);
 int steps_per_contact(const PhysicsParams& p);  // given, or from the tolerance
 float derived_dt(const PhysicsParams& p);
+inline float starting_skin(const PhysicsParams& p) { return p.skin > 0.0f ? p.skin : PhysicsParams::kStartSkin; }
 
 // Empty when the parameters are usable; otherwise a message that says which
 // value is wrong and what would be accepted.

@@ -60,7 +60,12 @@ void World::step() {
   vel_half_before_.swap(vel_half_);
   vel_half_.swap(vel_half_next_);
   move_players();
-  if (needs_rebuild_ || !lists_hold()) rebuild();
+  if (needs_rebuild_) {
+    rebuild();
+  } else if (!lists_hold() || skin_outlasts()) {
+    adapt_skin();
+    rebuild();
+  }
 
   PhaseTimer timer(phase_seconds_.step_pass);
   bound_lead(fastest_next_);
@@ -114,6 +119,28 @@ bool World::lists_hold() {
   if (std::find(chunk_missing_.begin(), chunk_missing_.end(), 1) != chunk_missing_.end()) return false;
   ++lists_kept_by_checks_;
   return true;
+}
+
+bool World::skin_outlasts() const {
+  // Lists that last skin x steps = kSkinCostRatio are the cheapest (adapt_skin): ones that last four
+  // times that (a pile come to rest) cost more per step than a build with a narrower skin.
+  constexpr float kOutlasting = 4.0f;
+  return params_.skin == 0.0f && skin_ > PhysicsParams::kMinSkin &&
+         skin_ * float(steps_ - built_at_step_) > kOutlasting * PhysicsParams::kSkinCostRatio;
+}
+
+void World::adapt_skin() {
+  if (params_.skin > 0.0f) return;
+  // The furthest any ball moved since the build, per step. A wider skin makes every step's lists
+  // longer and builds rarer (kSkinCostRatio). Counted in steps and distances, not seconds, so every
+  // thread count chooses the same skin.
+  const float drift = std::sqrt(next_max_d2_) / float(std::max<std::uint64_t>(steps_ - built_at_step_, 1));
+  const float skin = std::isfinite(drift) ? std::clamp(std::sqrt(2.0f * PhysicsParams::kSkinCostRatio * drift),
+                                                       PhysicsParams::kMinSkin, PhysicsParams::kMaxSkin)
+                                          : PhysicsParams::kMaxSkin;
+  if (skin == skin_) return;
+  skin_ = skin;
+  list_.configure(params_.tank, skin_);
 }
 
 void World::rebuild() {

@@ -61,7 +61,7 @@ struct TwoBalls {
 };
 TwoBalls two_balls(Float4 a_build, Float4 b_build, Float4 a_now, Float4 b_now) {
   TwoBalls t;
-  t.list.configure(TankBounds{}, PhysicsParams{}.skin);
+  t.list.configure(TankBounds{}, PhysicsParams::kStartSkin);
   t.at_build = {a_build, b_build};
   t.now = {a_now, b_now};
   for (std::uint32_t g = 0; g < kGhostSlots; ++g) t.at_build.push_back(kGhostPos), t.now.push_back(kGhostPos);
@@ -111,7 +111,8 @@ TEST_CASE("two balls closing head-on from beyond the skin get a rebuild before t
   // moves.
   const std::string variant = GENERATE(from_range(variant_names()));
   INFO(variant);
-  const PhysicsParams params = open_space();
+  PhysicsParams params = open_space();
+  params.skin = PhysicsParams::kStartSkin;  // fixed: each pair starts a known distance beyond it
   World world(params, kernels_named(variant), 1, 3);
   // A thousand resting balls well away from the pairs: for a dozen balls
   // alone a rebuild costs less than checking even one (World::lists_hold),
@@ -179,4 +180,58 @@ TEST_CASE("the check finds a contact between two large balls whose build positio
   CHECK(list.can_check(2.0f * edge - kMaxBallDiameter - 0.01f));
   CHECK_FALSE(list.can_check(2.0f * edge - kMaxBallDiameter + 0.01f));
   CHECK(list.misses_contact(0, now.data(), at_build.data(), 2.0f * edge - kMaxBallDiameter + 0.01f));
+}
+
+TEST_CASE("the skin follows the motion: sqrt(2 kSkinCostRatio x drift per step), within its bounds",
+          "[physics][broadphase]") {
+  // Balls 4 apart in open space, all at one velocity: nothing touches, and the
+  // lists last until they have drifted skin / 2. Fast balls take the widest
+  // skin, creeping ones the narrowest, and between the two the rule's.
+  const float speed = GENERATE(10.0f, 1.0f, 0.03f);
+  INFO("speed " << speed);
+  World world(open_space(), kScalarKernels, 1, 3);
+  for (int x = 0; x < 8; ++x)
+    for (int y = 0; y < 8; ++y)
+      for (int z = 0; z < 8; ++z)
+        world.place_ball(0, {-16.0f + 4.0f * x, 20.0f + 4.0f * y, -16.0f + 4.0f * z}, {speed, 0.0f, 0.0f});
+  REQUIRE(world.skin() == PhysicsParams::kStartSkin);
+  const float rule = std::sqrt(2.0f * PhysicsParams::kSkinCostRatio * speed * world.dt());
+  const int steps = int(4.0f / (speed * world.dt()) * std::max(rule, PhysicsParams::kStartSkin));  // a few builds
+  for (int s = 0; s < steps; ++s) world.step();
+  CHECK(world.rebuilds() >= 3);
+  if (rule > PhysicsParams::kMaxSkin)
+    CHECK(world.skin() == PhysicsParams::kMaxSkin);
+  else if (rule < PhysicsParams::kMinSkin)
+    CHECK(world.skin() == PhysicsParams::kMinSkin);
+  else
+    CHECK(world.skin() == Approx(rule).epsilon(0.02));
+}
+
+TEST_CASE("a given skin stays; the adaptive one widens while balls bounce and narrows once they rest",
+          "[physics][broadphase]") {
+  // Balls apart on the floor, thrown up at 10 m/s: they bounce lower each
+  // time (e = 0.6) and come to rest on the floor in about 5 s.
+  const std::string variant = GENERATE(from_range(variant_names()));
+  INFO(variant);
+  for (const float given : {PhysicsParams::kStartSkin, 0.0f}) {
+    PhysicsParams params;
+    params.skin = given;
+    World world(params, kernels_named(variant), 2, 3);
+    for (int x = 0; x < 8; ++x)
+      for (int z = 0; z < 8; ++z)
+        world.place_ball(0, {-16.0f + 4.0f * x, 0.5f, -16.0f + 4.0f * z}, {0.0f, 10.0f, 0.0f});
+    float widest = 0.0f;
+    for (int s = 0; s < int(8.0 / world.dt()); ++s) {
+      world.step();
+      widest = std::max(widest, world.skin());
+    }
+    REQUIRE(kinetic_energy(world) / world.ball_count() < 1e-6);  // at rest
+    if (given > 0.0f) {
+      CHECK(widest == given);
+      CHECK(world.skin() == given);
+    } else {
+      CHECK(widest == PhysicsParams::kMaxSkin);
+      CHECK(world.skin() == PhysicsParams::kMinSkin);
+    }
+  }
 }

@@ -89,7 +89,7 @@ TEST_CASE("the help text (--help) lists every flag and exits 0 without starting 
   }
   // Defaults are shown beside their flags.
   CHECK(r.message.find("--stiffness arg (=25000)") != std::string::npos);
-  CHECK(r.message.find("--skin arg (=0.2)") != std::string::npos);
+  CHECK(r.message.find("--skin arg (=0)") != std::string::npos);
 }
 
 TEST_CASE("the wide benchmark's flags give its spec, and a tank widened for the balls", "[options]") {
