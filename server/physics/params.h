@@ -46,7 +46,7 @@ struct PhysicsParams {
   static constexpr float kStartSkin = 0.2f, kMinSkin = 0.1f, kMaxSkin = 1.0f;
   // A build's cost per ball over what a unit of skin adds to each ball's step (longer lists), in
   // units x steps: the skin that minimises their sum is sqrt(2 kSkinCostRatio x the drift per step).
-  static constexpr float kSkinCostRatio = 100.0f;
+  static constexpr float kSkinCostRatio = 70.0f;
 };
 
 // Everything the kernels need, derived once from PhysicsParams.
