@@ -86,6 +86,7 @@ void World::place_ball(int kind, Vec3 p, Vec3 v) {
 
 void World::restart(const TankBounds& tank, std::uint64_t seed) {
   params_.tank = tank;
+  skin_ = starting_skin(params_);  // a restarted scene steps as a new one would
   list_.configure(tank, skin_);
   spawner_ = Spawner(tank, seed);
   capacity_ = capacity_of(tank);
