@@ -127,11 +127,6 @@ inline WholeWindowDamping whole_window_damping(const ContactModel& m, float c, f
 namespace {  // compiled with each SIMD file's flags: internal linkage (kernels_simd_ball.h)
 
 template <class V>
-[[gnu::always_inline]] inline V contact_damping(const ContactModel& m, V inv_m_sum) {
-  return V::splat(m.damping_factor) / sqrt(inv_m_sum);
-}
-
-template <class V>
 [[gnu::always_inline]] inline V whole_step_damping(const ContactModel& m, V c_f, V inv_m_sum) {
   return c_f / (V::splat(1.0f) + c_f * V::splat(m.half_dt) * inv_m_sum);
 }

@@ -216,30 +216,26 @@ struct KindDamping {
   }
 };
 
-// Each lane's dashpot from a per-kind row; a ball's kind is known by its 1 / mass.
+// Each lane's dashpot of_kind[its kind]; a ball's kind is known by its 1 / mass.
 template <class V>
-[[gnu::always_inline]] inline WholeDashpot<V> of_lane_kinds(V inv_m,
-                                                            const KindDamping::Dashpot (&of_kind)[kKindCount]) {
-  WholeDashpot<V> d{V::splat(of_kind[0].c), V::splat(of_kind[0].now), V::splat(of_kind[0].before)};
-  for (int k = 1; k < kKindCount; ++k) {
-    const auto lanes = inv_m == V::splat(1.0f / kBallKinds[k].mass);
-    d = {select(lanes, V::splat(of_kind[k].c), d.c), select(lanes, V::splat(of_kind[k].now), d.now),
-         select(lanes, V::splat(of_kind[k].before), d.before)};
-  }
-  return d;
-}
-
-// Of each lane's dashpots with every kind (of_kind, made per group), those with neighbours of 1 / mass inv_mj.
-template <class V>
-[[gnu::always_inline]] inline WholeDashpot<V> of_neighbour_kinds(V inv_mj,
-                                                                 const WholeDashpot<V> (&of_kind)[kKindCount]) {
+[[gnu::always_inline]] inline WholeDashpot<V> of_kinds(V inv_m, const WholeDashpot<V> (&of_kind)[kKindCount]) {
   WholeDashpot<V> d = of_kind[0];
   for (int k = 1; k < kKindCount; ++k) {
-    const auto lanes = inv_mj == V::splat(1.0f / kBallKinds[k].mass);
+    const auto lanes = inv_m == V::splat(1.0f / kBallKinds[k].mass);
     d = {select(lanes, of_kind[k].c, d.c), select(lanes, of_kind[k].now, d.now),
          select(lanes, of_kind[k].before, d.before)};
   }
   return d;
+}
+
+// Each lane's dashpot from a per-kind row of the table.
+template <class V>
+[[gnu::always_inline]] inline WholeDashpot<V> of_lane_kinds(V inv_m,
+                                                            const KindDamping::Dashpot (&of_kind)[kKindCount]) {
+  WholeDashpot<V> rows[kKindCount];
+  for (int k = 0; k < kKindCount; ++k)
+    rows[k] = {V::splat(of_kind[k].c), V::splat(of_kind[k].now), V::splat(of_kind[k].before)};
+  return of_kinds(inv_m, rows);
 }
 
 // A group's balls, one per lane.
@@ -335,7 +331,7 @@ template <bool kBranchFree, class V>
     // Lanes that are not near cannot start within the step (lead_bound bounds every lead).
     const V v_before = pair_rate_before(s, block, i, p);
     const auto whole_law = needs_whole_law(m, p.overlap, p.v_n, v_before);
-    V f = whole_or_no_contact_force(m, p.overlap, p.v_n, v_before, of_neighbour_kinds(p.inv_mj, kind_dashpot));
+    V f = whole_or_no_contact_force(m, p.overlap, p.v_n, v_before, of_kinds(p.inv_mj, kind_dashpot));
     if constexpr (kBranchFree) {  // those lanes' force comes from whole_law_forces
       f = select(whole_law, V::zero(), f);
       *deferred = {block, share};
