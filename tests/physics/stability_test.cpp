@@ -60,7 +60,7 @@ TEST_CASE("restitution near 0 and at 1 stays finite and contained", "[physics][s
 TEST_CASE("a pile of low e at the fewest steps per contact settles, and stays settled", "[physics][stability]") {
   // The dashpot takes the other contacts' forces from the last step (contact_law.h); an explicit
   // dashpot grew in dense piles whose damping rate x dt passes 0.5, as these do. How long a pour
-  // takes to settle varies with the pour (40-105 s at these settings), so the bound is loose.
+  // takes to settle varies with the pour (docs/accuracy.md), so the bound is loose.
   const float e = GENERATE(0.05f, 0.01f);
   PhysicsParams params;
   params.restitution = e;
