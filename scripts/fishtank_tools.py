@@ -310,6 +310,27 @@ def read_csv(path):
         return list(csv.DictReader(f))
 
 
+def step_kernel_instructions(callgrind_out, balls):
+    """Instructions per ball-step of the step kernel (kernels_*.cpp's step<...>) in a callgrind profile: its
+    inclusive count over its calls and the balls. None where the profile holds no step kernel."""
+    report = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--tree=calling", callgrind_out],
+                            check=True, stdout=subprocess.PIPE, text=True).stdout
+    # In the calling tree the kernel appears as "<Ir> (..%)  >   ...step<...>(...) (<calls>x) [...]"
+    # under its caller and as "<Ir> (..%)  *  ...step<...>(...) [...]" on its own line.
+    cost = calls = None
+    for line in report.splitlines():
+        if not re.search(r"anonymous namespace\)::step[<(]", line):
+            continue
+        m = re.match(r"\s*([\d,]+) \([^)]*\)\s+([>*])", line)
+        if not m:
+            continue
+        if m.group(2) == ">":
+            calls = int(re.search(r"\((\d[\d,]*)x\)", line).group(1).replace(",", ""))
+        else:
+            cost = int(m.group(1).replace(",", ""))
+    return cost / (calls * balls) if cost and calls else None
+
+
 # ------------------------------------------------------------------ LAMMPS's collisions
 
 COLLISION_RESTITUTIONS = [0.05, 0.3, 0.6, 0.9, 1.0]  # the product's collision sweep (server/accuracy/collisions.h)
