@@ -315,13 +315,13 @@ def step_kernel_instructions(callgrind_out, balls):
     inclusive count over its calls and the balls. None where the profile holds no step kernel."""
     report = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--tree=calling", callgrind_out],
                             check=True, stdout=subprocess.PIPE, text=True).stdout
-    # In the calling tree the kernel appears as "<Ir> (..%)  >   ...step<...>(...) (<calls>x) [...]"
-    # under its caller and as "<Ir> (..%)  *  ...step<...>(...) [...]" on its own line.
+    # In the calling tree the kernel appears as "<Ir> (..%)  >   ???:<type> ...step<...>(...) (<calls>x) [...]"
+    # under its caller and as "<Ir> (..%)  *  ???:<type> ...step<...>(...) [...]" on its own line; a function
+    # it calls that was not inlined names it only inside its own name, which does not count.
     cost = calls = None
     for line in report.splitlines():
-        if not re.search(r"anonymous namespace\)::step[<(]", line):
-            continue
-        m = re.match(r"\s*([\d,]+) \([^)]*\)\s+([>*])", line)
+        m = re.match(r"\s*([\d,]+) \([^)]*\)\s+([>*])\s+[^ (]*?:(?:[\w:]+ )?"
+                     r"fishtank::\(anonymous namespace\)::step[<(]", line)
         if not m:
             continue
         if m.group(2) == ">":
