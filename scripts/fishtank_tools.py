@@ -315,6 +315,11 @@ def step_kernel_instructions(callgrind_out, balls):
     inclusive count over its calls and the balls. None where the profile holds no step kernel."""
     report = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--tree=calling", callgrind_out],
                             check=True, stdout=subprocess.PIPE, text=True).stdout
+    return step_kernel_cost(report, balls)
+
+
+def step_kernel_cost(report, balls):
+    """step_kernel_instructions from callgrind_annotate's --inclusive=yes --tree=calling report."""
     # In the calling tree the kernel appears as "<Ir> (..%)  >   ???:<type> ...step<...>(...) (<calls>x) [...]"
     # under its caller and as "<Ir> (..%)  *  ???:<type> ...step<...>(...) [...]" on its own line; a function
     # it calls that was not inlined names it only inside its own name, which does not count.

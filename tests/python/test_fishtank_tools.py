@@ -1,5 +1,6 @@
 """scripts/fishtank_tools.py, which the scripts share: the per-round summaries give the median, min and max
-and the ratios within each round; rounds alternate their order; a real fishtank-server's port is read from
+and the ratios within each round; rounds alternate their order; the step kernel's instructions are read from
+its own lines of a callgrind report; a real fishtank-server's port is read from
 its 'listening on' line and answers; a server that cannot start says why."""
 
 import http.client
@@ -35,6 +36,25 @@ def test_round_ratios_divide_within_each_round_and_skip_a_round_without_its_base
 
 def test_rounds_alternate_their_order():
     assert [c for _, c in ft.interleaved("abc", 3)] == list("abccbaabc")
+
+
+def test_the_step_kernels_instructions_come_from_its_own_lines_not_from_a_callee_named_after_it():
+    step = ("fishtank::Moved fishtank::(anonymous namespace)::step<fishtank::simd::sse41::F4>"
+            "(fishtank::StepContext const&, unsigned int, unsigned int)")
+    callee = ("fishtank::(anonymous namespace)::for_each_group_of_batch<0, fishtank::simd::sse41::F4, "
+              "fishtank::(anonymous namespace)::step<fishtank::simd::sse41::F4>(fishtank::StepContext const&, "
+              "unsigned int, unsigned int)::{lambda()#1}>(fishtank::StepContext const&)")
+    report = "\n".join([
+        "60,003,402 (100.0%)  *  ???:fishtank::World::step() [harness]",
+        f"59,989,752 (99.98%)  >   ???:{step} (30x) [harness]",
+        "",
+        f"59,989,752 (99.98%)  *  ???:{step} [harness]",
+        f" 5,220,000 ( 8.70%)  >   ???:{callee} (3,840x) [harness]",
+        "",
+        f" 5,220,000 ( 8.70%)  *  ???:{callee} [harness]",
+    ])
+    assert ft.step_kernel_cost(report, 6000) == pytest.approx(59989752 / (30 * 6000))
+    assert ft.step_kernel_cost(report.replace("::step<", "::stepped<"), 6000) is None
 
 
 def test_every_variant_on_more_than_one_thread_is_fixed_to_its_threads():
