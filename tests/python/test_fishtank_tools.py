@@ -44,7 +44,7 @@ def test_the_step_kernels_instructions_come_from_its_own_lines_not_from_a_callee
     callee = ("fishtank::(anonymous namespace)::for_each_group_of_batch<0, fishtank::simd::sse41::F4, "
               "fishtank::(anonymous namespace)::step<fishtank::simd::sse41::F4>(fishtank::StepContext const&, "
               "unsigned int, unsigned int)::{lambda()#1}>(fishtank::StepContext const&)")
-    report = "\n".join([
+    annotated = "\n".join([
         "60,003,402 (100.0%)  *  ???:fishtank::World::step() [harness]",
         f"59,989,752 (99.98%)  >   ???:{step} (30x) [harness]",
         "",
@@ -53,8 +53,8 @@ def test_the_step_kernels_instructions_come_from_its_own_lines_not_from_a_callee
         "",
         f" 5,220,000 ( 8.70%)  *  ???:{callee} [harness]",
     ])
-    assert ft.step_kernel_cost(report, 6000) == pytest.approx(59989752 / (30 * 6000))
-    assert ft.step_kernel_cost(report.replace("::step<", "::stepped<"), 6000) is None
+    assert ft.step_kernel_cost(annotated, balls=6000) == pytest.approx(59989752 / (30 * 6000))
+    assert ft.step_kernel_cost(annotated.replace("::step<", "::stepped<"), balls=6000) is None
 
 
 def test_every_variant_on_more_than_one_thread_is_fixed_to_its_threads():
