@@ -246,6 +246,7 @@ class NeighbourList {
   // Room for `stride` neighbours of each of n balls, in groups of `lanes` (Kernels::list_lanes).
   void reserve(std::uint32_t n, std::uint32_t stride, std::uint32_t lanes);
 
+  float skin() const { return skin_; }  // the last configure's
   std::uint32_t stride() const { return stride_; }
   const std::uint32_t* neighbours() const { return neighbours_.get(); }
   const std::uint32_t* counts() const { return counts_.data(); }

@@ -22,12 +22,11 @@ std::uint32_t capacity_of(const TankBounds& tank) {
 World::World(const PhysicsParams& params, const Kernels& kernels, int threads, std::uint64_t seed)
     : params_(params),
       model_(make_contact_model(params)),
-      skin_(starting_skin(params)),
       kernels_(kernels),
       pool_(kernels.threaded ? threads : 1, kStepBatch),
       spawner_(params.tank, seed) {
   enable_flush_denormals_to_zero();
-  list_.configure(params.tank, skin_);
+  list_.configure(params.tank, starting_skin(params));
   capacity_ = capacity_of(params.tank);
   max_balls_ = capacity_;
   chunk_moved_.resize(pool_.max_chunks());
@@ -86,8 +85,7 @@ void World::place_ball(int kind, Vec3 p, Vec3 v) {
 
 void World::restart(const TankBounds& tank, std::uint64_t seed) {
   params_.tank = tank;
-  skin_ = starting_skin(params_);  // a restarted scene steps as a new one would
-  list_.configure(tank, skin_);
+  list_.configure(tank, starting_skin(params_));  // a restarted scene steps as a new one would
   spawner_ = Spawner(tank, seed);
   capacity_ = capacity_of(tank);
   max_balls_ = capacity_;

@@ -114,7 +114,7 @@ class World {
   double time() const { return time_; }
   std::uint64_t steps() const { return steps_; }
   std::uint64_t rebuilds() const { return rebuilds_; }
-  float skin() const { return skin_; }  // the lists' skin now (PhysicsParams::skin)
+  float skin() const { return list_.skin(); }  // the lists' skin now (PhysicsParams::skin)
   // Steps whose lists were kept after checking the balls that strayed more than skin / 2 (lists_hold()).
   std::uint64_t lists_kept_by_checks() const { return lists_kept_by_checks_; }
   // Balls checked in those steps and in the steps whose checks found a contact.
@@ -164,7 +164,7 @@ class World {
   void build_lists();
   // Whether the lists still hold every contact of the next step's positions.
   bool lists_hold();
-  float half_skin_d2() const { return 0.25f * skin_ * skin_; }  // (skin / 2)^2
+  float half_skin_d2() const { return 0.25f * skin() * skin(); }  // (skin / 2)^2
   // With PhysicsParams::skin 0, the skin for the next build, from how far balls moved per step since the last.
   void adapt_skin();
   // Whether the lists have lasted so long that a narrower skin would pay for a build.
@@ -189,7 +189,6 @@ class World {
 
   PhysicsParams params_;
   ContactModel model_;
-  float skin_;  // the lists' skin now: PhysicsParams::skin, or adapt_skin's
   const Kernels& kernels_;
   WorkerPool pool_;
   Spawner spawner_;

@@ -125,8 +125,8 @@ bool World::skin_outlasts() const {
   // Lists that last skin x steps = kSkinCostRatio are the cheapest (adapt_skin): ones that last four
   // times that (a pile come to rest) cost more per step than a build with a narrower skin.
   constexpr float kOutlasting = 4.0f;
-  return params_.skin == 0.0f && skin_ > PhysicsParams::kMinSkin &&
-         skin_ * float(steps_ - built_at_step_) > kOutlasting * PhysicsParams::kSkinCostRatio;
+  return params_.skin == 0.0f && skin() > PhysicsParams::kMinSkin &&
+         skin() * float(steps_ - built_at_step_) > kOutlasting * PhysicsParams::kSkinCostRatio;
 }
 
 void World::adapt_skin() {
@@ -138,9 +138,7 @@ void World::adapt_skin() {
   const float skin = std::isfinite(drift) ? std::clamp(std::sqrt(2.0f * PhysicsParams::kSkinCostRatio * drift),
                                                        PhysicsParams::kMinSkin, PhysicsParams::kMaxSkin)
                                           : PhysicsParams::kMaxSkin;
-  if (skin == skin_) return;
-  skin_ = skin;
-  list_.configure(params_.tank, skin_);
+  if (skin != list_.skin()) list_.configure(params_.tank, skin);
 }
 
 void World::rebuild() {
