@@ -13,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "common/server_hint.h"
 #include "viewer/clock.h"
 #include "viewer/frame_pacer.h"
 #include "viewer/frame_stats.h"

@@ -70,11 +70,4 @@ std::string control_text(bool may_control, const std::string& policy) {
   return (may_control ? "yours (P O R [ ] 1-4): " : "not yours: ") + policy;
 }
 
-std::string server_command_hint(const std::string& host, const std::string& port) {
-  const std::string server = "build/server/fishtank-server";
-  if (host == "127.0.0.1" || host == "localhost" || host == "::1")
-    return "To start a server here: " + server + " --port " + port;
-  return "To start a server on " + host + ": " + server + " --bind 0.0.0.0 --port " + port;
-}
-
 }  // namespace fishtank::viewer

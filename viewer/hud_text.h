@@ -43,9 +43,4 @@ std::string step_text(float dt, float steps_per_contact, float tolerance);
 // Who may use the sandbox's controls, for the HUD: this viewer's part first.
 std::string control_text(bool may_control, const std::string& policy);
 
-// The command that starts a server this viewer reaches at host:port, for the
-// window and the terminal while nothing answers there: "To start a server
-// here: build/server/fishtank-server --port 7913"; for another host, with --bind.
-std::string server_command_hint(const std::string& host, const std::string& port);
-
 }  // namespace fishtank::viewer

@@ -1,15 +1,18 @@
 """Errors a new user meets first say what happened and what to do, in one
 message, and nothing before it reads as success: --bench refuses more balls
 than the tank holds and says what fits; a port in use names --port and
---port 0, with no "Ctrl-C stops" banner first."""
+--port 0, with no "Ctrl-C stops" banner first; fishtank-client pointed where
+nothing listens gives the command that starts a server there."""
 
 import os
 import re
 import signal
+import socket
 import subprocess
 import time
 
 SERVER = os.path.join(os.environ["FISHTANK_BUILD_DIR"], "server", "fishtank-server")
+CLIENT = os.path.join(os.environ["FISHTANK_BUILD_DIR"], "client", "fishtank-client")
 
 
 def test_bench_with_more_balls_than_fit_refuses_in_one_line_that_says_what_fits():
@@ -41,3 +44,16 @@ def test_a_port_in_use_names_the_flag_and_port_0_and_no_banner_comes_first():
     assert f"cannot listen on 127.0.0.1:{port}" in second.stderr
     assert "--port P" in second.stderr and "--port 0" in second.stderr
     assert "Ctrl-C stops" not in second.stderr and "listening on" not in second.stderr
+
+
+def test_a_client_with_no_server_says_where_why_and_the_command_that_starts_one_there():
+    with socket.socket() as probe:  # a port just freed: nothing listens there
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    run = subprocess.run([CLIENT, "--connect", f"127.0.0.1:{port}", "--duration", "1"], capture_output=True,
+                         text=True, timeout=30)
+    assert run.returncode == 1
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1, run.stderr
+    assert f"no connection to 127.0.0.1:{port}: cannot connect: Connection refused" in lines[0]
+    assert lines[0].endswith(f"To start a server here: build/server/fishtank-server --port {port}"), lines[0]

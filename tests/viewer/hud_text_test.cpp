@@ -5,7 +5,10 @@
 
 #include <catch2/catch.hpp>
 
+#include "common/server_hint.h"
+
 using namespace fishtank::viewer;
+using fishtank::server_command_hint;
 
 TEST_CASE("an overlap beyond a tenth of the smaller radius is a warning, a lighter one a plain figure") {
   const OverlapText light = overlap_text(0.042f);
