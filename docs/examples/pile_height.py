@@ -13,6 +13,7 @@ against simulated time since the restart.
 """
 
 import argparse
+import sys
 import time
 
 import matplotlib
@@ -21,7 +22,7 @@ matplotlib.use("Agg")  # write a file; no display needed
 import matplotlib.pyplot as plt
 import numpy as np
 
-from fishtank import Client
+from fishtank import Client, FishtankError
 
 REST_DISTANCE = 0.02  # metres in REST_WINDOW: below it a ball counts as resting
 REST_WINDOW = 0.1  # seconds of wall time between the two snapshots compared
@@ -79,4 +80,7 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except FishtankError as e:  # the server's or the connection's reason says what to do: no traceback
+        sys.exit(f"pile_height.py: {e}")

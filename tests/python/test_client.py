@@ -7,7 +7,10 @@ and leave the connection working."""
 import os
 import socket
 import stat
+import subprocess
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -144,6 +147,19 @@ def test_a_port_where_nothing_listens_raises_fishtank_error_with_the_address_and
     assert refused.value.code == "cannot_connect"
     assert f"127.0.0.1:{port}" in refused.value.message
     assert f"build/server/fishtank-server --port {port}" in refused.value.message
+
+
+def test_the_example_with_no_server_says_why_and_what_to_do_in_one_line_without_a_traceback():
+    with socket.socket() as probe:  # a port just freed: nothing listens there
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    example = Path(__file__).resolve().parents[2] / "docs" / "examples" / "pile_height.py"
+    run = subprocess.run([sys.executable, example, "--port", str(port), "--seconds", "1"], capture_output=True,
+                         text=True, timeout=60, env={**os.environ, "MPLBACKEND": "Agg"})
+    assert run.returncode == 1
+    assert run.stderr.strip().splitlines() == [
+        f"pile_height.py: cannot_connect: nothing listens at 127.0.0.1:{port} (connection refused); start a server "
+        f"there with build/server/fishtank-server --port {port}, or use the port its 'listening on' line shows"]
 
 
 def test_a_peer_that_never_answers_raises_fishtank_error_timeout_with_the_address_in_time():
