@@ -1,8 +1,9 @@
 """Errors a new user meets first say what happened and what to do, in one
 message, and nothing before it reads as success: --bench refuses more balls
 than the tank holds and says what fits; a port in use names --port and
---port 0, with no "Ctrl-C stops" banner first; fishtank-client pointed where
-nothing listens gives the command that starts a server there."""
+--port 0, with no "Ctrl-C stops" banner first; a final-state path that cannot
+be written is refused before the run, not after it; fishtank-client pointed
+where nothing listens gives the command that starts a server there."""
 
 import os
 import re
@@ -44,6 +45,29 @@ def test_a_port_in_use_names_the_flag_and_port_0_and_no_banner_comes_first():
     assert f"cannot listen on 127.0.0.1:{port}" in second.stderr
     assert "--port P" in second.stderr and "--port 0" in second.stderr
     assert "Ctrl-C stops" not in second.stderr and "listening on" not in second.stderr
+
+
+def test_final_state_paths_that_cannot_be_written_are_refused_before_anything_runs(tmp_path):
+    a_file = tmp_path / "a-file"
+    a_file.write_text("")
+    refusals = {
+        ("--dump", str(tmp_path / "missing" / "final.csv")): f"the folder {tmp_path / 'missing'} does not exist",
+        ("--dump", str(tmp_path)): "is a folder",
+        ("--export-lammps", str(a_file / "lammps")): "cannot create",
+    }
+    for (flag, path), why in refusals.items():
+        for mode in (["--bench", "--balls", "200", "--steps", "100"], ["--port", "0", "--no-web", "--duration", "5"]):
+            run = subprocess.run([SERVER, *mode, flag, path], capture_output=True, text=True, timeout=30)
+            assert run.returncode == 2, (mode, run.stderr)
+            lines = run.stderr.strip().splitlines()
+            assert len(lines) == 1 and lines[0].startswith(f"fishtank-server: {flag} {path}: "), run.stderr
+            assert why in lines[0], lines[0]
+            assert run.stdout == ""  # no benchmark ran, no server listened
+    made = tmp_path / "made" / "lammps"  # a folder that can be made is made, and the run goes ahead
+    run = subprocess.run([SERVER, "--bench", "--balls", "200", "--steps", "100", "--export-lammps", str(made)],
+                         capture_output=True, text=True, timeout=60)
+    assert run.returncode == 0, run.stderr
+    assert (made / "data.fishtank").exists() and (made / "in.fishtank").exists()
 
 
 def test_a_client_with_no_server_says_where_why_and_the_command_that_starts_one_there():
