@@ -149,6 +149,15 @@ def test_a_port_where_nothing_listens_raises_fishtank_error_with_the_address_and
     assert f"build/server/fishtank-server --port {port}" in refused.value.message
 
 
+def test_a_port_or_timeout_out_of_range_is_refused_before_any_connection_with_the_range():
+    for port in (0, 70000, "7878", 7878.0, True):
+        with pytest.raises(ValueError, match=r"port must be a whole number from 1 to 65535"):
+            Client("127.0.0.1", port)
+    for timeout in (0, -1):
+        with pytest.raises(ValueError, match=r"timeout must be a positive number of seconds"):
+            Client("127.0.0.1", 7878, timeout=timeout)
+
+
 def test_the_example_with_no_server_says_why_and_what_to_do_in_one_line_without_a_traceback():
     with socket.socket() as probe:  # a port just freed: nothing listens there
         probe.bind(("127.0.0.1", 0))
