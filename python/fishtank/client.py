@@ -6,6 +6,8 @@ The controls wait until a snapshot shows their effect, so a script reads
 like the experiment it runs; a refusal from the server raises FishtankError.
 """
 
+import math
+import numbers
 import socket
 import struct
 import time
@@ -60,6 +62,14 @@ class Snapshot:
     max_overlap: float  # largest overlap, a fraction of the smaller radius; beyond 0.1 k is too soft
     tank_min: np.ndarray  # (3,) float32
     tank_max: np.ndarray
+
+
+def _whole_number(value, what, lowest):
+    """value as an int, or ValueError naming what: the wire's unsigned fields would refuse it less clearly,
+    and a fraction would be cut silently."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < lowest:
+        raise ValueError(f"{what} must be a whole number of at least {lowest}, got {value!r}")
+    return int(value)
 
 
 def _vec(v):
@@ -140,7 +150,14 @@ class Client:
         """Sets the player sphere's velocity (metres per second, x y z); it keeps it until the next move()."""
         if self.player_id is None:
             raise FishtankError("no_player", "this client has no player sphere to move")
-        x, y, z = (float(c) for c in velocity)
+        # Checked here, not refused by the server later: move() does not wait, so a refusal would be raised
+        # by whichever call came next.
+        try:
+            x, y, z = (float(c) for c in velocity)
+        except (TypeError, ValueError):
+            raise ValueError(f"velocity must be three numbers (x, y, z) in m/s, got {velocity!r}") from None
+        if not all(math.isfinite(c) for c in (x, y, z)):
+            raise ValueError(f"velocity must be finite, got {velocity!r}")
         self._sequence += 1
 
         def build(b):
@@ -154,7 +171,8 @@ class Client:
 
     def add_balls(self, n):
         """Asks the server to pour n more balls in from the top; raises FishtankError if it took fewer."""
-        self._send(_frame(Payload.Payload.AddBalls, lambda b: self._table(b, AddBalls, AddCount=int(n))))
+        n = _whole_number(n, "add_balls' n", 0)
+        self._send(_frame(Payload.Payload.AddBalls, lambda b: self._table(b, AddBalls, AddCount=n)))
         self._round_trip()
 
     def pause(self):
@@ -168,8 +186,9 @@ class Client:
 
     def step(self, n=1):
         """Runs n steps while paused and returns the snapshot taken once they are done."""
+        n = _whole_number(n, "step's n", 1)
         before = self._current().physics_steps
-        self._send(_frame(Payload.Payload.Step, lambda b: self._table(b, Step, AddCount=int(n))))
+        self._send(_frame(Payload.Payload.Step, lambda b: self._table(b, Step, AddCount=n)))
         return self._wait_for(lambda s: (s.physics_steps - before) % 2**32 >= n)
 
     def reset(self, seed=None):
@@ -230,6 +249,7 @@ class Client:
         return module.End(b)
 
     def _restart(self, name, seed):
+        seed = None if seed is None else _whole_number(seed, "seed", 0)
         before = self._current().scene_start
 
         def build(b):
@@ -238,7 +258,7 @@ class Client:
             if text is not None:
                 Reset.AddScene(b, text)
             if seed is not None:
-                Reset.AddSeed(b, int(seed))
+                Reset.AddSeed(b, seed)
             return Reset.End(b)
 
         self._send(_frame(Payload.Payload.Reset, build))

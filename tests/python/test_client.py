@@ -158,6 +158,24 @@ def test_a_port_or_timeout_out_of_range_is_refused_before_any_connection_with_th
             Client("127.0.0.1", 7878, timeout=timeout)
 
 
+def test_arguments_the_wire_cannot_carry_raise_value_error_at_once_and_the_next_refusal_is_the_right_one(
+        start_server):
+    server = start_server("--balls", "100")
+    with Client("127.0.0.1", server.port) as tank:
+        for bad in ((1, 2), "abc", (float("nan"), 0, 0), (0, float("inf"), 0)):
+            with pytest.raises(ValueError, match="velocity must be"):
+                tank.move(bad)
+        for call, bad in ((tank.add_balls, -5), (tank.add_balls, 1.5), (tank.step, 0), (tank.step, -1),
+                          (tank.reset, -1), (lambda seed: tank.scene("drop", seed=seed), 2.5)):
+            with pytest.raises(ValueError, match="must be a whole number of at least"):
+                call(bad)
+        # Nothing of the above reached the server: the refusal a time scale of 5 raises is its own.
+        with pytest.raises(FishtankError) as refused:
+            tank.time_scale(5)
+        assert refused.value.code == "invalid_value" and "SetTimeScale" in refused.value.message
+        assert tank.errors == [refused.value]
+
+
 def test_the_example_with_no_server_says_why_and_what_to_do_in_one_line_without_a_traceback():
     with socket.socket() as probe:  # a port just freed: nothing listens there
         probe.bind(("127.0.0.1", 0))
