@@ -115,8 +115,11 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   if (pause && resume) return fail("--pause and --resume contradict each other; give one");
   if (step < 0 || step > protocol::kMaxStepsPerRequest)
     return fail("--step must be between 0 and " + std::to_string(protocol::kMaxStepsPerRequest));
-  if (!vm["time-scale"].empty() && !(time_scale >= protocol::kMinTimeScale && time_scale <= protocol::kMaxTimeScale))
-    return fail("--time-scale must be between 0.1 and 1, got " + std::to_string(time_scale));
+  if (!vm["time-scale"].empty() && !(time_scale >= protocol::kMinTimeScale && time_scale <= protocol::kMaxTimeScale)) {
+    std::ostringstream got;  // 5, not std::to_string's 5.000000
+    got << time_scale;
+    return fail("--time-scale must be between 0.1 and 1, got " + got.str());
+  }
   if (!vm["scene"].empty() && (scene.empty() || scene.size() > protocol::kMaxSceneNameBytes))
     return fail("--scene wants a scene's name (tank, wide, dam-break or drop)");
   if (!vm["seed"].empty() && seed < 0) return fail("--seed must be >= 0");
