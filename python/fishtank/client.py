@@ -103,8 +103,9 @@ class Client:
 
     def __init__(self, host="127.0.0.1", port=7878, player=True, name="fishtank-python", timeout=10.0):
         # Checked here: the socket layer would wrap 70000 to another port, or fail in its own words.
-        if isinstance(port, bool) or not isinstance(port, int) or not 0 < port < 65536:
-            raise ValueError(f"port must be a whole number from 1 to 65535, got {port!r}")
+        port = _whole_number(port, "port", 1)
+        if port > 65535:
+            raise ValueError(f"port must be at most 65535, got {port}")
         if not (isinstance(timeout, (int, float)) and timeout > 0):
             raise ValueError(f"timeout must be a positive number of seconds, got {timeout!r}")
         self.timeout = timeout
