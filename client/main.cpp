@@ -36,8 +36,8 @@ int main(int argc, char** argv) {
       });
   if (!s.connect_error.empty()) {
     std::cerr << "fishtank-client: no connection to " << o.script.host << ":" << o.script.port << ": "
-              << s.connect_error << ". " << fishtank::server_command_hint(o.script.host, std::to_string(o.script.port))
-              << "\n";
+              << s.connect_error << ". "
+              << fishtank::connection_advice(o.script.host, std::to_string(o.script.port), s.connect_error) << "\n";
     return 1;
   }
   const double bytes_per_ball = per_ball(s.bytes_per_s, s.snapshot_rate_hz, s.balls);

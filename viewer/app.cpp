@@ -87,7 +87,7 @@ class FullscreenToggle {
 };
 
 // The terminal hears of each new reason that no connection is made once, not at every retry.
-void report_connection(const ConnectionStatus& s, const std::string& hint, std::string& reported) {
+void report_connection(const ConnectionStatus& s, const std::string& advice, std::string& reported) {
   if (s.state == ConnectionStatus::State::connected) {
     if (!reported.empty()) std::fprintf(stderr, "fishtank-viewer: connected to %s\n", s.endpoint.c_str());
     reported.clear();
@@ -96,7 +96,7 @@ void report_connection(const ConnectionStatus& s, const std::string& hint, std::
   if (s.last_error.empty() || s.last_error == reported) return;
   reported = s.last_error;
   std::fprintf(stderr, "fishtank-viewer: no connection to %s: %s; retrying every second. %s\n",
-               s.endpoint.c_str(), s.last_error.c_str(), hint.c_str());
+               s.endpoint.c_str(), s.last_error.c_str(), advice.c_str());
 }
 
 // The exit summary: the rates of the frames that drew the scene, or, when none
@@ -190,7 +190,6 @@ int run_viewer(const ViewerOptions& opt) {
     std::vector<SphereInstance> instances;
     TankBounds framed;  // the camera frames the tank again only if a server's tank differs
     int frames_since_snapshot = 0;
-    const std::string server_hint = server_command_hint(opt.host, opt.port);
     std::string reported_error;
     const double started = steady_seconds();
 
@@ -221,7 +220,8 @@ int run_viewer(const ViewerOptions& opt) {
       RenderPair pair;
       const bool have_frame = snapshots.frame_at(frame_start, pair);
       const ConnectionStatus status = net.status();
-      report_connection(status, server_hint, reported_error);
+      const std::string advice = connection_advice(opt.host, opt.port, status.last_error);
+      report_connection(status, advice, reported_error);
       int own = -1;
       instances.clear();
       if (have_frame && status.info) {
@@ -239,7 +239,7 @@ int run_viewer(const ViewerOptions& opt) {
       view.frame_ms = stats.frame_ms();
       view.cpu_ms = stats.cpu_ms();
       view.net = &status;
-      view.server_hint = server_hint;
+      view.connection_advice = advice;
       view.snapshot = newest.get();
       view.render_delay_ms = static_cast<float>(1e3 * snapshots.render_delay());
       view.observer = opt.observer;

@@ -171,7 +171,7 @@ void Hud::connection(const HudView& v) {
     ImGui::SetWindowFontScale(1.0f);
     ImGui::Text("%s", net.last_error.c_str());
     ImGui::Text("Retrying every second (%d attempt%s so far).", net.attempts, net.attempts == 1 ? "" : "s");
-    ImGui::Text("%s", v.server_hint.c_str());
+    ImGui::Text("%s", v.connection_advice.c_str());
   }
   ImGui::End();
 }

@@ -19,7 +19,7 @@ struct HudView {
   float frame_ms = 0.0f;
   float cpu_ms = 0.0f;  // per frame, outside GL calls
   const ConnectionStatus* net = nullptr;
-  std::string server_hint;             // how to start the server it looks for (server_command_hint)
+  std::string connection_advice;       // what to do while no connection is made (connection_advice)
   const Snapshot* snapshot = nullptr;  // newest; null before the first
   float render_delay_ms = 0.0f;
   bool observer = false;

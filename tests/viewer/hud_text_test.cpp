@@ -8,6 +8,7 @@
 #include "common/server_hint.h"
 
 using namespace fishtank::viewer;
+using fishtank::connection_advice;
 using fishtank::server_command_hint;
 
 TEST_CASE("an overlap beyond a tenth of the smaller radius is a warning, a lighter one a plain figure") {
@@ -86,4 +87,13 @@ TEST_CASE("while no server answers, the hint is the exact command that starts on
         "To start a server here: build/server/fishtank-server --port 7878");
   CHECK(server_command_hint("otherhost", "7913") ==
         "To start a server on otherhost: build/server/fishtank-server --bind 0.0.0.0 --port 7913");
+}
+
+TEST_CASE(
+    "a name that does not resolve is to be checked; any other failure gets the command that starts a "
+    "server") {
+  CHECK(connection_advice("nohost", "7878", "cannot resolve nohost: Host not found (authoritative)") ==
+        "Check the host name, or give its IP address.");
+  CHECK(connection_advice("127.0.0.1", "7913", "cannot connect: Connection refused") ==
+        server_command_hint("127.0.0.1", "7913"));
 }
