@@ -224,6 +224,9 @@ class Client:
             raise FishtankError("cannot_connect", f"nothing listens at {self.address} (connection refused); start a "
                                 f"server there with build/server/fishtank-server --port {port}, or use the port "
                                 "its 'listening on' line shows") from None
+        except socket.gaierror as e:
+            raise FishtankError("cannot_connect", f"cannot resolve {host}: {e.strerror or e}; check the host name, "
+                                "or give its IP address") from None
         except TimeoutError:
             raise FishtankError("timeout", f"no answer from {self.address} within {self.timeout:g} s; check "
                                 "the address, and that a server on another machine was started with "

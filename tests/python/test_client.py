@@ -191,6 +191,18 @@ def test_the_example_with_no_server_says_why_and_what_to_do_in_one_line_without_
         f"there with build/server/fishtank-server --port {port}, or use the port its 'listening on' line shows"]
 
 
+def test_a_host_name_that_does_not_resolve_raises_cannot_connect_saying_to_check_it(monkeypatch):
+    def unknown(address, timeout):  # what the resolver says of an unknown name, without asking one
+        raise socket.gaierror(socket.EAI_NONAME, "Name or service not known")
+
+    monkeypatch.setattr(socket, "create_connection", unknown)
+    with pytest.raises(FishtankError) as refused:
+        Client("nohost.invalid", 7878)
+    assert refused.value.code == "cannot_connect"
+    assert refused.value.message == ("cannot resolve nohost.invalid: Name or service not known; check the host name, "
+                                     "or give its IP address")
+
+
 def test_a_peer_that_never_answers_raises_fishtank_error_timeout_with_the_address_in_time():
     with socket.socket() as silent:  # accepts connections (the kernel's backlog) and never says a word
         silent.bind(("127.0.0.1", 0))
