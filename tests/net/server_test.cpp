@@ -428,7 +428,7 @@ TEST_CASE("a client that acknowledges gets deltas that decode to the positions a
   CHECK(acking->stats().errors.empty());
 }
 
-TEST_CASE("Acks that cannot be true get an Error and a keyframe; the connection and other clients go on",
+TEST_CASE("Acks that cannot be true get an Error and a keyframe, and the connection and other clients go on",
           "[net][delta]") {
   ServerProcess server({"--balls", "300"});
   Clients clients(server.port());

@@ -110,7 +110,7 @@ TEST_CASE("a delta rebuilds every quantised value of the snapshot exactly, whate
   }
 }
 
-TEST_CASE("balls at rest cost one bit; a quantum of jitter a few more", "[protocol][delta]") {
+TEST_CASE("balls at rest cost one bit, a quantum of jitter a few more", "[protocol][delta]") {
   std::vector<std::uint16_t> base(3 * 8000, 30000);
   std::vector<std::uint16_t> now = base;
   protocol::PositionsDelta d;

@@ -100,7 +100,7 @@ TEST_CASE("over a pour, a settle and a plough, every delta decodes to the full s
   for (int c = 0; c < 3; ++c) CHECK(clients[c].bytes_per_ball() < clients[3].bytes_per_ball());
 }
 
-TEST_CASE("clients that acknowledged the same snapshot share one frame; an unknown base gets a keyframe",
+TEST_CASE("clients that acknowledged the same snapshot share one frame, and an unknown base gets a keyframe",
           "[net][delta]") {
   net::SnapshotHistory history;
   const auto snapshot_at = [](std::uint32_t tick) {
@@ -133,7 +133,7 @@ TEST_CASE("clients that acknowledged the same snapshot share one frame; an unkno
   }
 }
 
-TEST_CASE("an Ack the client cannot have meant gets an Error, then a keyframe; the connection stays", "[net][delta]") {
+TEST_CASE("an Ack the client cannot have meant gets an Error, then a keyframe, and the connection stays", "[net][delta]") {
   net::ServerInfo info;
   info.variant = "sse";
   info.simd = "sse4.1";

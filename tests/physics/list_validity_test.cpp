@@ -207,7 +207,7 @@ TEST_CASE("the skin follows the motion: sqrt(2 kSkinCostRatio x drift per step),
     CHECK(world.skin() == Approx(rule).epsilon(0.02));
 }
 
-TEST_CASE("a given skin stays; the adaptive one widens while balls bounce and narrows once they rest",
+TEST_CASE("a given skin stays, and the adaptive one widens while balls bounce and narrows once they rest",
           "[physics][broadphase]") {
   // Balls apart on the floor, thrown up at 10 m/s: they bounce lower each
   // time (e = 0.6) and come to rest on the floor in about 5 s.

@@ -167,7 +167,7 @@ std::vector<int> cpus_of_this_thread() {
 }
 }  // namespace
 
-TEST_CASE("while every thread steps, each is pinned to a CPU of its own; below that, all are free again", "[pool]") {
+TEST_CASE("while every thread steps, each is pinned to a CPU of its own, and below that all are free again", "[pool]") {
   const std::vector<int> allowed = cpus_of_this_thread();
   if (allowed.size() < 2) {
     WARN("SKIPPED: one CPU: the pool never pins, nothing to check");

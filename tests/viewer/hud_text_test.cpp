@@ -67,7 +67,7 @@ TEST_CASE("the time scale reads real time at 1, slow motion with its factor belo
   CHECK(time_scale_text(0.0f) == "-");
 }
 
-TEST_CASE("a time scale people set is not slow motion; a shortfall against it is, and paused says so") {
+TEST_CASE("a time scale people set is not slow motion, a shortfall against it is, and paused says so") {
   CHECK(time_scale_text(0.5f, 0.5f) == "\u00d70.50 as set");
   CHECK(time_scale_text(0.49f, 0.5f) == "\u00d70.50 as set");  // jitter
   CHECK(time_scale_text(0.30f, 0.5f) == "slow motion \u00d70.30 (\u00d70.50 set)");
@@ -90,7 +90,7 @@ TEST_CASE("while no server answers, the hint is the exact command that starts on
 }
 
 TEST_CASE(
-    "a name that does not resolve is to be checked; any other failure gets the command that starts a "
+    "a name that does not resolve is to be checked, any other failure gets the command that starts a "
     "server") {
   CHECK(connection_advice("nohost", "7878", "cannot resolve nohost: Host not found (authoritative)") ==
         "Check the host name, or give its IP address.");

@@ -38,7 +38,7 @@ TEST_CASE("P pauses a running server and resumes a paused one, O pauses before i
   CHECK(sandbox_frames(p, nullptr).empty());  // nothing known yet: nothing sent
 }
 
-TEST_CASE("[ and ] walk the time scale ladder 0.1, 0.25, 0.5, 1 and stop at its ends") {
+TEST_CASE("the slower and faster keys walk the time scale ladder 0.1, 0.25, 0.5, 1 and stop at its ends") {
   CHECK(next_time_scale(1.0f, -1) == 0.5f);
   CHECK(next_time_scale(0.5f, -1) == 0.25f);
   CHECK(next_time_scale(0.1f, -1) == 0.1f);
