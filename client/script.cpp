@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "client/connection.h"
+#include "common/server_hint.h"
 
 namespace fishtank::client {
 
@@ -89,7 +90,7 @@ Summary run_script(const Script& script, const std::function<void(const Interval
   const auto resolved = resolver.resolve(script.host, std::to_string(script.port), ec);
   if (ec || resolved.empty()) {
     Summary failed;
-    failed.connect_error = "cannot resolve " + script.host + ": " + ec.message();
+    failed.connect_error = cannot_resolve_text(script.host, ec.message());
     return failed;
   }
   const asio::ip::tcp::endpoint server = *resolved.begin();

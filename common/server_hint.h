@@ -1,10 +1,11 @@
 #pragma once
 // What a client tells its user while nothing answers at the address it tried:
 // the exact command that starts a server there, or, for a name that does not
-// resolve, to check it. The viewer and fishtank-client
-// say the same (the Python client says it in its own words).
+// resolve, to check it. The viewer and fishtank-client say the same (the
+// Python client says it in its own words).
 
 #include <string>
+#include <string_view>
 
 namespace fishtank {
 
@@ -16,11 +17,17 @@ inline std::string server_command_hint(const std::string& host, const std::strin
   return "To start a server on " + host + ": " + server + " --bind 0.0.0.0 --port " + port;
 }
 
-// What to do about error, a client's reason that no connection was made to host:port ("cannot resolve ..."
-// from the name lookup, "cannot connect: ..." from the connect): check a name that does not resolve; for
-// any other, start a server there.
+inline constexpr std::string_view kCannotResolve = "cannot resolve ";
+
+// A client's reason that the name lookup of host failed, why: the one form connection_advice recognises.
+inline std::string cannot_resolve_text(const std::string& host, const std::string& why) {
+  return std::string(kCannotResolve) + host + ": " + why;
+}
+
+// What to do about error, a client's reason that no connection was made to host:port: check a name that
+// does not resolve (cannot_resolve_text); for any other failure, start a server there.
 inline std::string connection_advice(const std::string& host, const std::string& port, const std::string& error) {
-  if (error.rfind("cannot resolve", 0) == 0) return "Check the host name, or give its IP address.";
+  if (error.rfind(kCannotResolve, 0) == 0) return "Check the host name, or give its IP address.";
   return server_command_hint(host, port);
 }
 

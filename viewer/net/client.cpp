@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstring>
 
+#include "common/server_hint.h"
 #include "viewer/clock.h"
 
 namespace fishtank::viewer {
@@ -76,7 +77,7 @@ void NetClient::do_connect() {
   resolver_.async_resolve(
       host_, port_, [this, gen](error_code ec, const tcp::resolver::results_type& results) {
         if (gen != generation_) return;
-        if (ec) return lose("cannot resolve " + host_ + ": " + ec.message());
+        if (ec) return lose(cannot_resolve_text(host_, ec.message()));
         asio::async_connect(socket_, results, [this, gen](error_code ec, const tcp::endpoint&) {
           if (gen != generation_) return;
           if (ec) return lose("cannot connect: " + ec.message());
