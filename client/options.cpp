@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "common/host_port.h"
 #include "protocol/frame_codec.h"
 
 namespace fishtank::client {
@@ -20,20 +21,6 @@ std::optional<Vec3> parse_vec3(const std::string& text) {
   if (std::sscanf(text.c_str(), "%f,%f,%f%n", &v.x, &v.y, &v.z, &consumed) != 3) return std::nullopt;
   if (static_cast<std::size_t>(consumed) != text.size() || !is_finite(v)) return std::nullopt;
   return v;
-}
-
-// "host:port"
-bool split_host_port(const std::string& text, std::string& host, std::uint16_t& port) {
-  const std::size_t colon = text.rfind(':');
-  if (colon == std::string::npos || colon == 0) return false;
-  const std::string port_text = text.substr(colon + 1);
-  if (port_text.empty() || port_text.size() > 5 || port_text.find_first_not_of("0123456789") != std::string::npos)
-    return false;
-  const long value = std::stol(port_text);
-  if (value < 1 || value > 65535) return false;
-  host = text.substr(0, colon);
-  port = static_cast<std::uint16_t>(value);
-  return true;
 }
 
 }  // namespace
@@ -98,8 +85,10 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
     result.message = help.str();
     return result;
   }
-  if (!split_host_port(connect, o.script.host, o.script.port))
-    return fail("--connect wants host:port with a port 1 .. 65535, got '" + connect + "'");
+  const auto address = parse_host_port(connect);
+  if (!address) return fail("--connect wants host:port with a port 1 .. 65535, got '" + connect + "'");
+  o.script.host = address->host;
+  o.script.port = address->port;
   if (clients < 1 || clients > 1000) return fail("--clients must be between 1 and 1000");
   if (add < 0 || add > protocol::kMaxAddBallsPerRequest)
     return fail("--add must be between 0 and " + std::to_string(protocol::kMaxAddBallsPerRequest));

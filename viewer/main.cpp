@@ -4,8 +4,10 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <sstream>
 #include <string>
 
+#include "common/host_port.h"
 #include "viewer/app.h"
 #include "viewer/frame_pacer.h"
 
@@ -34,42 +36,36 @@ int main(int argc, char** argv) {
        "Mesa's llvmpipe, which shares the CPU with the server)")  //
       ("duration", po::value(&opt.duration),
        "close the viewer after this many seconds (default 0: stay open)");
+  // Every bad flag: one line that says what is wrong, the pointer to --help, exit code 2.
+  auto refuse = [](const std::string& why) {
+    std::fprintf(stderr, "fishtank-viewer: %s\nTry --help for the list of options.\n", why.c_str());
+    return 2;
+  };
   po::variables_map vm;
   try {
     po::store(po::parse_command_line(argc, argv, flags), vm);
     po::notify(vm);
   } catch (const po::error& e) {
-    std::fprintf(stderr, "fishtank-viewer: %s (see --help)\n", e.what());
-    return 2;
+    return refuse(e.what());
   }
   if (vm.count("help")) {
     std::cout << flags << "\n";
     return 0;
   }
   opt.hud = vm.count("no-hud") == 0;
-  const auto colon = connect.rfind(':');
-  if (colon == std::string::npos || colon == 0 || colon + 1 == connect.size()) {
-    std::fprintf(stderr, "fishtank-viewer: --connect wants host:port, got '%s'\n", connect.c_str());
-    return 2;
-  }
-  opt.host = connect.substr(0, colon);
-  if (opt.host.size() > 2 && opt.host.front() == '[' && opt.host.back() == ']')  // [::1]:7878
-    opt.host = opt.host.substr(1, opt.host.size() - 2);
-  opt.port = connect.substr(colon + 1);
-  if (opt.frames < 1) {
-    std::fprintf(stderr, "fishtank-viewer: --frames must be at least 1\n");
-    return 2;
-  }
-  if (vm.count("max-fps") && (opt.max_fps < 0 || opt.max_fps > fishtank::viewer::FramePacer::kMaxFps)) {
-    std::fprintf(stderr, "fishtank-viewer: --max-fps must be between 0 (no cap) and %d, got %d\n",
-                 fishtank::viewer::FramePacer::kMaxFps, opt.max_fps);
-    return 2;
-  }
+  const auto address = fishtank::parse_host_port(connect);
+  if (!address) return refuse("--connect wants host:port with a port 1 .. 65535, got '" + connect + "'");
+  opt.host = address->host;
+  opt.port = std::to_string(address->port);
+  if (opt.frames < 1) return refuse("--frames must be at least 1, got " + std::to_string(opt.frames));
+  if (vm.count("max-fps") && (opt.max_fps < 0 || opt.max_fps > fishtank::viewer::FramePacer::kMaxFps))
+    return refuse("--max-fps must be between 0 (no cap) and " +
+                  std::to_string(fishtank::viewer::FramePacer::kMaxFps) + ", got " +
+                  std::to_string(opt.max_fps));
   if (!std::isfinite(opt.duration) || opt.duration < 0.0 || opt.duration > 1e9) {
-    std::fprintf(stderr,
-                 "fishtank-viewer: --duration must be a number of seconds >= 0 (0: stay open), got %g\n",
-                 opt.duration);
-    return 2;
+    std::ostringstream got;
+    got << opt.duration;
+    return refuse("--duration must be a number of seconds >= 0 (0: stay open), got " + got.str());
   }
   return fishtank::viewer::run_viewer(opt);
 }
