@@ -87,24 +87,31 @@ int run_bench(const fishtank::ServerOptions& o) {
   fishtank::World world(o.physics, kKernels, o.threads, o.bench_spec.scene.seed);
   fishtank::TunedStepper stepper(world, !o.fixed_threads);
   if (!apply_max_balls(world, o)) return 2;
-  // A benchmark times the count asked for or nothing: refused before any is poured.
-  if (o.bench_spec.scene.name == "tank" && o.bench_spec.scene.balls > world.max_balls()) {
-    std::cerr << "fishtank-server: --bench refuses --balls " << o.bench_spec.scene.balls << ": the tank holds at most "
-              << world.max_balls() << "; use --balls " << world.max_balls() << " or fewer, or --scene wide for more\n";
-    return 2;
+  // A benchmark times the count asked for or nothing: refused before any is poured. The default count, 6000,
+  // becomes what the scene holds where that is fewer.
+  fishtank::BenchSpec bench = o.bench_spec;
+  const std::string& scene = bench.scene.name;
+  if (const std::uint32_t holds = fishtank::scene_capacity(world, scene); bench.scene.balls > holds) {
+    if (o.balls_given) {
+      std::cerr << "fishtank-server: --bench refuses --balls " << bench.scene.balls << ": the " << scene
+                << (scene == "tank" ? "" : " scene") << " holds at most " << holds << "; use --balls " << holds
+                << " or fewer, or --scene wide for more\n";
+      return 2;
+    }
+    bench.scene.balls = holds;
   }
   fishtank::TrajectoryRecorder recorder(o.record);
   if (!open_recording(recorder)) return 1;
-  if (std::string refusal = fishtank::populate(world, o.bench_spec.scene); !refusal.empty()) {
+  if (std::string refusal = fishtank::populate(world, bench.scene); !refusal.empty()) {
     std::cerr << "fishtank-server: --bench refuses: " << refusal << "\n";
     return 2;
   }
-  fishtank::SettleReport settled = fishtank::settle(stepper, o.bench_spec.scene);
+  fishtank::SettleReport settled = fishtank::settle(stepper, bench.scene);
   if (!settled.settled)
     std::cerr << "fishtank-server: warning: not at rest after " << settled.sim_seconds
               << " simulated seconds; timing anyway\n";
-  std::cerr << "timing " << o.bench_spec.steps << " steps of " << world.ball_count() << " balls\n";
-  nlohmann::json report = fishtank::time_steps(stepper, o.bench_spec, settled);
+  std::cerr << "timing " << bench.steps << " steps of " << world.ball_count() << " balls\n";
+  nlohmann::json report = fishtank::time_steps(stepper, bench, settled);
   if (const std::string warning = overlap_warning(world); !warning.empty())
     std::cerr << "fishtank-server: warning: " << warning << "\n";
   std::cout << report.dump(2) << std::endl;

@@ -43,9 +43,10 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "always step on every --threads thread, never on one instead: to time the pool itself")(
       "seed", po::value(&seed)->default_value(seed), "random seed for spawning, >= 0")(
       "scene", po::value(&o.bench_spec.scene.name)->default_value("tank"), scene_help().c_str())(
-      "balls", po::value(&balls), "balls of every scene (default: the scene's, 1000 for tank; with --bench, 6000)")(
-      "max-balls", po::value(&max_balls)->default_value(0),
-      "most balls the tank may hold (0: its capacity, ~6100; more is refused)")(
+      "balls", po::value(&balls),
+      "balls of every scene (default: the scene's, 1000 for tank; with --bench, 6000, or as many as the "
+      "scene holds where that is fewer)")("max-balls", po::value(&max_balls)->default_value(0),
+                                          "most balls the tank may hold (0: its capacity, ~6100; more is refused)")(
       "duration", po::value(&o.duration)->default_value(0.0), "stop after this many seconds (0: run until Ctrl-C)")(
       "status-interval", po::value(&o.status_interval)->default_value(1.0), "seconds between status lines");
 

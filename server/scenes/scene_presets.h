@@ -30,7 +30,11 @@ struct SceneSpec {
 std::uint32_t default_balls(const std::string& name);
 // Tank bounds the scene needs for this many balls.
 TankBounds scene_tank(const SceneSpec& spec);
-// Puts the scene's balls in (queued or placed); returns a refusal message or "".
+// Most balls the scene holds in world's tank: the tank's capacity, or what its lattices fit with none touching
+// (wide's tank, from scene_tank, fits the count it was sized for).
+std::uint32_t scene_capacity(const World& world, const std::string& name);
+// Puts the scene's balls in (queued or placed), as many as it holds; returns "" or a refusal that says how many
+// it holds and how many went in.
 std::string populate(World& world, const SceneSpec& spec);
 
 }  // namespace fishtank

@@ -63,6 +63,35 @@ TEST_CASE("every placed preset holds exactly its balls, inside its tank, none to
   CHECK(poured.ball_count() + poured.pending() == 1000);  // poured in from the top over the first steps
 }
 
+TEST_CASE("a placed scene filled to what it says it holds takes every ball with none touching", "[scenes]") {
+  for (const char* name : {"dam-break", "drop"}) {
+    INFO(name);
+    SceneSpec spec = preset(name);
+    World world = world_for(spec);
+    spec.balls = scene_capacity(world, name);
+    CHECK(spec.balls > default_balls(name));
+    REQUIRE(populate(world, spec).empty());
+    CHECK(world.ball_count() == spec.balls);
+    CHECK(escaped_or_invalid(world) == 0);
+    CHECK(closest_gap(world) > 0.0f);
+  }
+}
+
+TEST_CASE("one ball more than a scene holds places what it holds and says both counts", "[scenes]") {
+  for (const char* name : {"dam-break", "drop"}) {
+    INFO(name);
+    SceneSpec spec = preset(name);
+    World world = world_for(spec);
+    const std::uint32_t holds = scene_capacity(world, name);
+    spec.balls = holds + 1;
+    CHECK(populate(world, spec) == "the " + std::string(name) + " scene holds at most " + std::to_string(holds) +
+                                       " balls; " + std::to_string(holds + 1) + " were asked for, " +
+                                       std::to_string(holds) + " placed");
+    CHECK(world.ball_count() == holds);
+    CHECK(closest_gap(world) > 0.0f);
+  }
+}
+
 TEST_CASE("the dam-break column stands against the -x wall and spreads across the floor once released", "[scenes]") {
   const SceneSpec spec = preset("dam-break");
   World world = world_for(spec);

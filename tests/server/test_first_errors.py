@@ -1,10 +1,12 @@
 """Errors a new user meets first say what happened and what to do, in one
 message, and nothing before it reads as success: --bench refuses more balls
-than the tank holds and says what fits; a port in use names --port and
+than the tank holds and says what fits, as on a scene that holds fewer, where
+its default count becomes what fits; a port in use names --port and
 --port 0, with no "Ctrl-C stops" banner first; a final-state path that cannot
 be written is refused before the run, not after it; fishtank-client pointed
 where nothing listens gives the command that starts a server there."""
 
+import json
 import os
 import re
 import signal
@@ -24,6 +26,25 @@ def test_bench_with_more_balls_than_fit_refuses_in_one_line_that_says_what_fits(
     fits = re.search(r"refuses --balls 7000: the tank holds at most (\d+); use --balls (\d+) or fewer", lines[0])
     assert fits and fits.group(1) == fits.group(2) and 5000 < int(fits.group(1)) < 7000, lines[0]
     assert "added" not in run.stderr and run.stdout == ""
+
+
+def test_bench_on_a_scene_that_holds_fewer_says_what_it_holds_and_that_count_runs():
+    run = subprocess.run([SERVER, "--bench", "--scene", "drop", "--balls", "6000"], capture_output=True, text=True,
+                         timeout=30)
+    assert run.returncode == 2
+    holds = re.fullmatch(r"fishtank-server: --bench refuses --balls 6000: the drop scene holds at most (\d+); "
+                         r"use --balls (\d+) or fewer, or --scene wide for more", run.stderr.strip())
+    assert holds and holds.group(1) == holds.group(2), run.stderr
+    quick = ["--steps", "10", "--windows", "1", "--settle-time", "0.05"]
+    given = subprocess.run([SERVER, "--bench", "--scene", "drop", "--balls", holds.group(1), *quick],
+                           capture_output=True, text=True, timeout=120)
+    assert given.returncode == 0, given.stderr
+    assert json.loads(given.stdout)["balls"] == int(holds.group(1))
+    # Without --balls the benchmark's 6000 becomes what the scene holds, instead of a refusal.
+    default = subprocess.run([SERVER, "--bench", "--scene", "drop", *quick], capture_output=True, text=True,
+                             timeout=120)
+    assert default.returncode == 0, default.stderr
+    assert json.loads(default.stdout)["balls"] == int(holds.group(1))
 
 
 def test_a_port_in_use_names_the_flag_and_port_0_and_no_banner_comes_first():
