@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "common/flag_values.h"
 #include "common/host_port.h"
 #include "protocol/frame_codec.h"
 
@@ -67,7 +68,7 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   };
   po::variables_map vm;
   try {
-    po::store(po::parse_command_line(argc, argv, flags), vm);
+    po::store(parse_flags(argc, argv, flags), vm);
     po::notify(vm);
   } catch (const po::error& e) {
     return fail(e.what());

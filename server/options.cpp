@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "common/flag_values.h"
 #include "common/scene_names.h"
 #include "server/physics/worker_pool.h"
 #include "server/scenes/scene_presets.h"
@@ -144,7 +145,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
        << all;
   po::variables_map vm;
   try {
-    po::store(po::parse_command_line(argc, argv, all), vm);
+    po::store(parse_flags(argc, argv, all), vm);
     po::notify(vm);
   } catch (const po::error& e) {
     result.exit_code = 2;

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <string>
 
+#include "common/flag_values.h"
 #include "common/host_port.h"
 #include "viewer/app.h"
 #include "viewer/frame_pacer.h"
@@ -43,7 +44,7 @@ int main(int argc, char** argv) {
   };
   po::variables_map vm;
   try {
-    po::store(po::parse_command_line(argc, argv, flags), vm);
+    po::store(fishtank::parse_flags(argc, argv, flags), vm);
     po::notify(vm);
   } catch (const po::error& e) {
     return refuse(e.what());

@@ -13,19 +13,23 @@
 // and prints a summary. --quick runs a coarse sweep (seconds); --scalar and
 // --avx2 use those kernels instead of the SSE ones fishtank-server ships.
 
+#include <boost/program_options.hpp>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <fstream>
+#include <iostream>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "common/flag_values.h"
 #include "server/accuracy/collisions.h"
 #include "server/accuracy/reference.h"
 #include "server/accuracy/rows.h"
 #include "server/accuracy/stability.h"
 #include "server/accuracy/sweep.h"
+#include "server/export/output_paths.h"
 #include "server/physics/kernels.h"
 #include "server/physics/params.h"
 
@@ -43,36 +47,48 @@ struct Options {
   const Kernels* kernels = &kSseKernels;
 };
 
-constexpr const char* kUsage =
-    "usage: fishtank-accuracy [--out DIR] [--quick] [--scalar | --avx2] [--collisions-only]\n"
-    "The measurements behind docs/accuracy.md: single collisions against the contact model's exact e,\n"
-    "rows of balls, error against dt for each scheme, and the stability map, as CSV files in DIR.\n"
-    "  --out DIR          where the CSV files go (default .)\n"
-    "  --quick            a coarse sweep, a few seconds\n"
-    "  --scalar, --avx2   those kernels instead of the SSE ones fishtank-server ships\n"
-    "  --collisions-only  only collisions.csv and restitutions.csv (the tolerance rule)\n";
+namespace po = boost::program_options;
 
-// 0: run; 1: --help was asked; -1: a bad argument, named on stderr.
-int parse(int argc, char** argv, Options& o) {
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h"))
-      return 1;
-    else if (!std::strcmp(argv[i], "--out") && i + 1 < argc)
-      o.out = argv[++i];
-    else if (!std::strcmp(argv[i], "--quick"))
-      o.quick = true;
-    else if (!std::strcmp(argv[i], "--collisions-only"))
-      o.collisions_only = true;
-    else if (!std::strcmp(argv[i], "--scalar"))
-      o.kernels = &kScalarKernels;
-    else if (!std::strcmp(argv[i], "--avx2"))
-      o.kernels = &kAvx2Kernels;
-    else {
-      std::fprintf(stderr, "fishtank-accuracy: unknown argument '%s'\n", argv[i]);
-      return -1;
-    }
+// The options, or why not: exit code 0 (--help, printed) or 2 (a bad flag, named on stderr).
+std::optional<Options> parse(int argc, char** argv, int& exit_code) {
+  Options o;
+  bool scalar = false, avx2 = false;
+  po::options_description flags(
+      "usage: fishtank-accuracy [--out DIR] [--quick] [--scalar | --avx2] [--collisions-only]\n"
+      "The measurements behind docs/accuracy.md: single collisions against the contact model's exact e,\n"
+      "rows of balls, error against dt for each scheme, and the stability map, as CSV files in DIR.\n\nOptions");
+  flags.add_options()                                                                                              //
+      ("help,h", "print this help and exit")                                                                       //
+      ("out", po::value(&o.out), "where the CSV files go, made if missing (default .)")                            //
+      ("quick", po::bool_switch(&o.quick), "a coarse sweep, a few seconds")                                        //
+      ("scalar", po::bool_switch(&scalar), "the plain C++ kernels instead of the SSE ones fishtank-server ships")  //
+      ("avx2", po::bool_switch(&avx2), "the AVX2 kernels instead")                                                 //
+      ("collisions-only", po::bool_switch(&o.collisions_only),
+       "only collisions.csv and restitutions.csv (the tolerance rule)");
+  exit_code = 2;
+  auto refuse = [](const std::string& why) {
+    std::fprintf(stderr, "fishtank-accuracy: %s\nTry --help for the list of options.\n", why.c_str());
+    return std::nullopt;
+  };
+  po::variables_map vm;
+  try {
+    po::store(parse_flags(argc, argv, flags), vm);
+    po::notify(vm);
+  } catch (const po::error& e) {
+    return refuse(e.what());
   }
-  return 0;
+  if (vm.count("help")) {
+    std::cout << flags << "\n";
+    exit_code = 0;
+    return std::nullopt;
+  }
+  if (scalar && avx2) return refuse("--scalar and --avx2 each choose the kernels; give one of them");
+  if (avx2 && !cpu_has_avx2()) return refuse("this processor has no AVX2; leave out --avx2");
+  o.kernels = scalar ? &kScalarKernels : avx2 ? &kAvx2Kernels : &kSseKernels;
+  // Checked before minutes of sweeps, so that they cannot end in "cannot write".
+  if (const std::string why = prepare_writable_folder(o.out); !why.empty())
+    return refuse("--out " + o.out + ": " + why);
+  return o;
 }
 
 std::ofstream open_csv(const Options& o, const char* name, const char* header) {
@@ -211,15 +227,10 @@ void run_stability(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  Options o;
-  if (const int parsed = parse(argc, argv, o); parsed != 0) {
-    std::fputs(kUsage, parsed > 0 ? stdout : stderr);
-    return parsed > 0 ? 0 : 2;
-  }
-  if (o.kernels == &kAvx2Kernels && !cpu_has_avx2()) {
-    std::fprintf(stderr, "fishtank-accuracy: this processor has no AVX2; leave out --avx2\n");
-    return 2;
-  }
+  int exit_code = 0;
+  const std::optional<Options> parsed = parse(argc, argv, exit_code);
+  if (!parsed) return exit_code;
+  const Options& o = *parsed;
   try {
     run_collisions(o);
     if (o.collisions_only) return 0;

@@ -195,6 +195,10 @@ TEST_CASE("every bad value is refused with a message naming it and exit code 2",
       {{"--add-rights", "observers"}, "--add-rights must be players, everyone or nobody"},
       {{"--add-rate", "-5"}, "--add-rate"},
       {{"--no-such-flag"}, "no-such-flag"},
+      // A flag whose value is forgotten would take the next flag as its value.
+      {{"--record", "--bench"}, "--record wants a value, got the flag '--bench'"},
+      {{"--dump", "--balls", "10"}, "--dump wants a value, got the flag '--balls'"},
+      {{"--dt=--x"}, "--dt wants a value, got the flag '--x'"},
   };
   for (const Bad& b : bad) {
     std::string line;
