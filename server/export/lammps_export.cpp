@@ -110,11 +110,14 @@ std::string export_lammps(const World& world, const std::string& dir, std::uint6
   return write_input(world, dir + "/in.fishtank", run_steps);
 }
 
-LammpsDumpWriter::~LammpsDumpWriter() { close(); }
+LammpsDumpWriter::~LammpsDumpWriter() { close(); }  // an owner that cares asked close() first
 
-void LammpsDumpWriter::close() {
-  if (file_) std::fclose(file_);
+std::string LammpsDumpWriter::close() {
+  if (!file_) return "";
+  bool ok = std::fflush(file_) == 0 && !std::ferror(file_);
+  ok = std::fclose(file_) == 0 && ok;
   file_ = nullptr;
+  return ok ? "" : "error while writing " + path_;
 }
 
 std::string LammpsDumpWriter::open(const std::string& path) {

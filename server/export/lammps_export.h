@@ -37,7 +37,9 @@ class LammpsDumpWriter {
 
   std::string open(const std::string& path);  // "" or why it failed
   std::string write_frame(const World& world);
-  void close();  // the frames so far are complete on disk; no more are written
+  // The frames so far are complete on disk, and no more are written; "" or why the last of them were not
+  // (the C library writes its buffer out only now, so a full disk may show here first).
+  std::string close();
   std::uint64_t frames() const { return frames_; }
 
  private:

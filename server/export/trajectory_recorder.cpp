@@ -13,7 +13,17 @@ std::string TrajectoryRecorder::at_step_boundary(const World& world) {
   return world.steps() < next_frame_ ? "" : write(world);
 }
 
-std::string TrajectoryRecorder::finish(const World& world) { return last_step_ == world.steps() ? "" : write(world); }
+std::string TrajectoryRecorder::finish(const World& world) {
+  const std::string note = last_step_ == world.steps() ? "" : write(world);
+  return failed_ ? note : closed(note);
+}
+
+std::string TrajectoryRecorder::closed(const std::string& note) {
+  const std::string error = writer_.close();
+  if (error.empty()) return note;
+  failed_ = true;
+  return error + "; the recording's last frames are lost";
+}
 
 std::string TrajectoryRecorder::write(const World& world) {
   if (ended_ || world.time() < options_.from || world.ball_count() == 0) return "";
@@ -21,7 +31,7 @@ std::string TrajectoryRecorder::write(const World& world) {
     if (frames() == 0 && world.pending() > 0) return "";  // balls are still pouring in
     if (frames() > 0 && world.ball_count() != count_) {
       ended_ = true;
-      writer_.close();
+      if (const std::string error = closed(""); !error.empty()) return error;
       char why[256];
       std::snprintf(why, sizeof why,
                     "recording ended at t = %.3f s: the ball count changed from %u to %u, and "

@@ -1,7 +1,8 @@
 // When the trajectory gets its frames: a recording from the start of a pour
 // holds no empty frame (ASE cannot read one) and ends with the final state;
 // none comes before --record-from; a constant-count recording waits for the
-// pour to finish and ends, saying why, when the count changes.
+// pour to finish and ends, saying why, when the count changes; a write that
+// fails when the file is closed (a full disk) fails the recording, said.
 
 #include "server/export/trajectory_recorder.h"
 
@@ -153,4 +154,20 @@ TEST_CASE("without a path nothing is recorded and nothing fails", "[export][reco
   CHECK(recorder.finish(world).empty());
   CHECK(recorder.frames() == 0);
   CHECK_FALSE(recorder.failed());
+}
+
+TEST_CASE("a recording whose last frames cannot reach the disk says so when it finishes, and fails",
+          "[export][record]") {
+  if (!std::filesystem::exists("/dev/full")) {
+    WARN("SKIPPED: no /dev/full here (every write to it fails, as on a full disk)");
+    return;
+  }
+  World world(PhysicsParams{}, kSseKernels, 1, 3);
+  world.add_balls(5);
+  TrajectoryRecorder recorder({"/dev/full", 1000, 0.0, false});
+  REQUIRE(recorder.open().empty());
+  CHECK(run(world, recorder, 30).empty());  // a few small frames: all still in the C library's buffer
+  const std::string note = recorder.finish(world);
+  CHECK(note == "error while writing /dev/full; the recording's last frames are lost");
+  CHECK(recorder.failed());
 }
