@@ -7,3 +7,20 @@ case "${1:-}" in
     exit 0
     ;;
 esac
+
+# For a script whose only arguments are positional (a build folder, say): refuses an option, or more than
+# $1 arguments, with the usage line, instead of reading "--bogus" as a folder's name.
+positional_only() {
+  local most=$1
+  shift
+  for arg in "$@"; do
+    if [[ $arg == -* ]]; then
+      echo "$(basename "$0"): unknown option '$arg'; see $0 --help" >&2
+      exit 2
+    fi
+  done
+  if (($# > most)); then
+    echo "$(basename "$0"): at most $most argument(s), got $#: $*; see $0 --help" >&2
+    exit 2
+  fi
+}
