@@ -172,7 +172,7 @@ class Client:
 
     def add_balls(self, n):
         """Asks the server to pour n more balls in from the top; raises FishtankError if it took fewer."""
-        n = _whole_number(n, "add_balls' n", 0)
+        n = _whole_number(n, "add_balls' n", 1)
         self._send(_frame(Payload.Payload.AddBalls, lambda b: self._table(b, AddBalls, AddCount=n)))
         self._round_trip()
 

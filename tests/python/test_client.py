@@ -167,7 +167,7 @@ def test_arguments_the_wire_cannot_carry_raise_value_error_at_once_and_the_next_
         for bad in ((1, 2), "abc", (float("nan"), 0, 0), (0, float("inf"), 0)):
             with pytest.raises(ValueError, match="velocity must be"):
                 tank.move(bad)
-        for call, bad in ((tank.add_balls, -5), (tank.add_balls, 1.5), (tank.step, 0), (tank.step, -1),
+        for call, bad in ((tank.add_balls, -5), (tank.add_balls, 0), (tank.add_balls, 1.5), (tank.step, 0), (tank.step, -1),
                           (tank.reset, -1), (lambda seed: tank.scene("drop", seed=seed), 2.5)):
             with pytest.raises(ValueError, match="must be a whole number of at least"):
                 call(bad)
