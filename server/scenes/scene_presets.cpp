@@ -84,7 +84,7 @@ std::uint32_t scene_capacity(const World& world, const std::string& name) {
   if (name == "tank") return world.max_balls();
   if (name == "dam-break") return lattice_fit(t.min, dam_top(t), kSmallSpacing);
   if (name == "drop") {
-    // The large tenth bounds it first (its lattice is the smaller); then the bed, which rises as balls are added.
+    // The most balls whose large tenth fits the lattice under the ceiling and whose rest fits the bed below it.
     const std::uint32_t large = lattice_fit(drop_bottom(t), t.max, kLatticeSpacing);
     const std::uint32_t bed = lattice_fit(t.min, bed_top(t), kSmallSpacing);
     std::uint32_t balls = large * kDropShare + (kDropShare - 1);
