@@ -3,6 +3,7 @@
 #include <pthread.h>
 #include <time.h>
 
+#include <boost/asio/ip/host_name.hpp>
 #include <csignal>
 #include <cstdio>
 
@@ -18,6 +19,11 @@ double cpu_seconds(clockid_t clock) {
 double thread_cpu_seconds(std::thread& thread) {
   clockid_t clock;
   return pthread_getcpuclockid(thread.native_handle(), &clock) == 0 ? cpu_seconds(clock) : 0.0;
+}
+
+// An address as a URL or --connect writes it: an IPv6 one in brackets ([::1]:7878).
+std::string url_host(const boost::asio::ip::address& address) {
+  return address.is_v6() ? "[" + address.to_string() + "]" : address.to_string();
 }
 
 }  // namespace
@@ -50,11 +56,17 @@ std::string NetworkService::start() {
   }
   const auto endpoint = server_.local_endpoint();
   // Tests and scripts parse these lines to find an ephemeral port.
-  std::fprintf(stderr, "listening on %s:%u\n", endpoint.address().to_string().c_str(), endpoint.port());
+  std::fprintf(stderr, "listening on %s:%u\n", url_host(endpoint.address()).c_str(), endpoint.port());
   if (options_.web) {
     const auto web = server_.web_endpoint();
-    const std::string host = web.address().is_v6() ? "[" + web.address().to_string() + "]" : web.address().to_string();
-    std::fprintf(stderr, "web viewer on http://%s:%u/\n", host.c_str(), web.port());
+    std::fprintf(stderr, "web viewer on http://%s:%u/\n", url_host(web.address()).c_str(), web.port());
+  }
+  // 0.0.0.0 is no address to give a room: name this machine, which the others reach it by.
+  if (endpoint.address().is_unspecified()) {
+    const std::string name = boost::asio::ip::host_name();
+    std::fprintf(stderr, "from other machines, by this machine's name %s (or its IP address):", name.c_str());
+    if (options_.web) std::fprintf(stderr, " a browser at http://%s:%u/,", name.c_str(), server_.web_endpoint().port());
+    std::fprintf(stderr, " fishtank-viewer --connect %s:%u\n", name.c_str(), endpoint.port());
   }
   std::fflush(stderr);
   io_thread_ = std::thread([this] { io_.run(); });

@@ -4,7 +4,8 @@ than the tank holds and says what fits, as on a scene that holds fewer, where
 its default count becomes what fits; a port in use names --port and
 --port 0, with no "Ctrl-C stops" banner first; a final-state path that cannot
 be written is refused before the run, not after it; fishtank-client pointed
-where nothing listens gives the command that starts a server there."""
+where nothing listens gives the command that starts a server there; a server
+bound to every address names this machine for the others, not 0.0.0.0."""
 
 import json
 import os
@@ -102,3 +103,17 @@ def test_a_client_with_no_server_says_where_why_and_the_command_that_starts_one_
     assert len(lines) == 1, run.stderr
     assert f"no connection to 127.0.0.1:{port}: cannot connect: Connection refused" in lines[0]
     assert lines[0].endswith(f"To start a server here: build/server/fishtank-server --port {port}"), lines[0]
+
+
+def test_a_server_that_takes_other_machines_names_this_machine_for_them_not_0_0_0_0():
+    run = subprocess.run([SERVER, "--bind", "0.0.0.0", "--port", "0", "--web-port", "0", "--threads", "1",
+                          "--duration", "0.5"], capture_output=True, text=True, timeout=30)
+    assert run.returncode == 0, run.stderr
+    port = re.search(r"^listening on 0\.0\.0\.0:(\d+)$", run.stderr, re.M).group(1)
+    web_port = re.search(r"^web viewer on http://0\.0\.0\.0:(\d+)/$", run.stderr, re.M).group(1)
+    name = socket.gethostname()
+    assert (f"from other machines, by this machine's name {name} (or its IP address): a browser at "
+            f"http://{name}:{web_port}/, fishtank-viewer --connect {name}:{port}") in run.stderr.splitlines()
+    local = subprocess.run([SERVER, "--port", "0", "--no-web", "--threads", "1", "--duration", "0.5"],
+                           capture_output=True, text=True, timeout=30)
+    assert "from other machines" not in local.stderr  # 127.0.0.1: no other machine gets in
