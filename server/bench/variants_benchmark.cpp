@@ -202,6 +202,19 @@ void step_wide(benchmark::State& state) {
   time_steps(state, world);
 }
 
+// --help: what this program times and how to call it, then Google Benchmark's own flags.
+void print_help() {
+  std::printf(
+      "fishtank-bench-variants: Google Benchmark of whole physics steps, every kernel set in one process.\n"
+      "  step_tank/<variant>/<threads>  the settled 6000-ball tank (scalar, sse, avx2; 1 thread and every core)\n"
+      "  build_lists/<variant>          one neighbour-list build of that tank\n"
+      "  step_wide/sse/<balls>          the wide scene at 10^4, 10^5 and 10^6 balls (minutes to build)\n"
+      "Example: fishtank-bench-variants --benchmark_filter=step_tank --benchmark_repetitions=5 \\\n"
+      "           --benchmark_enable_random_interleaving=true\n"
+      "scripts/callgrind-step counts its instructions per ball-step under valgrind.\n\n");
+  benchmark::PrintDefaultHelp();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -227,7 +240,7 @@ int main(int argc, char** argv) {
       ->Arg(1000000)
       ->Iterations(50)
       ->Unit(benchmark::kMillisecond);
-  benchmark::Initialize(&argc, argv);
+  benchmark::Initialize(&argc, argv, print_help);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   // The cores' placement, which moves the small scenes' two-thread figures
   // (line_transfer.h): in the run's context before, on stderr after.
