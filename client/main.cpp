@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "client/options.h"
+#include "common/host_port.h"
 #include "common/server_hint.h"
 
 int main(int argc, char** argv) {
@@ -35,9 +36,10 @@ int main(int argc, char** argv) {
                     << " bytes, " << bytes_per_ball << " bytes per ball per snapshot\n";
       });
   if (!s.connect_error.empty()) {
-    std::cerr << "fishtank-client: no connection to " << o.script.host << ":" << o.script.port << ": "
-              << s.connect_error << ". "
-              << fishtank::connection_advice(o.script.host, std::to_string(o.script.port), s.connect_error) << "\n";
+    std::cerr << "fishtank-client: no connection to "
+              << fishtank::host_port_text(o.script.host, std::to_string(o.script.port)) << ": " << s.connect_error
+              << ". " << fishtank::connection_advice(o.script.host, std::to_string(o.script.port), s.connect_error)
+              << "\n";
     return 1;
   }
   const double bytes_per_ball = per_ball(s.bytes_per_s, s.snapshot_rate_hz, s.balls);

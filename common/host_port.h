@@ -30,4 +30,9 @@ inline std::optional<HostPort> parse_host_port(std::string_view text) {
   return HostPort{std::string(host), static_cast<std::uint16_t>(port)};
 }
 
+// host:port as --connect takes it back: an IPv6 address in brackets ("[::1]:7878").
+inline std::string host_port_text(const std::string& host, const std::string& port) {
+  return (host.find(':') == std::string::npos ? host : "[" + host + "]") + ":" + port;
+}
+
 }  // namespace fishtank

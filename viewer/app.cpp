@@ -13,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "common/host_port.h"
 #include "common/server_hint.h"
 #include "viewer/clock.h"
 #include "viewer/frame_pacer.h"
@@ -140,7 +141,7 @@ int run_viewer(const ViewerOptions& opt) {
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
   glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);  // SPEC 5.2: 1280x1024 or full screen
-  const std::string title = "Fishtank - " + opt.host + ":" + opt.port;
+  const std::string title = "Fishtank - " + host_port_text(opt.host, opt.port);
   GLFWwindow* window = glfwCreateWindow(kWindowWidth, kWindowHeight, title.c_str(), nullptr, nullptr);
   if (!window) {
     std::fprintf(stderr, "fishtank-viewer: cannot create a 1280x1024 OpenGL 3.3 core window\n");

@@ -16,7 +16,7 @@ namespace po = boost::program_options;
 
 int main(int argc, char** argv) {
   fishtank::viewer::ViewerOptions opt;
-  std::string connect = opt.host + ":" + opt.port;
+  std::string connect = fishtank::host_port_text(opt.host, opt.port);
   po::options_description flags(
       "fishtank-viewer: shows a fishtank-server's simulation and steers a player sphere in it.\n"
       "Usage: fishtank-viewer [--connect host:port] [--fullscreen] [--observer]\n"

@@ -27,3 +27,13 @@ TEST_CASE("a port that cannot exist, or no host, is refused rather than tried", 
     CHECK_FALSE(parse_host_port(bad));
   }
 }
+
+TEST_CASE("host:port is written back as --connect reads it, an IPv6 address in brackets", "[net][flags]") {
+  CHECK(fishtank::host_port_text("127.0.0.1", "7878") == "127.0.0.1:7878");
+  CHECK(fishtank::host_port_text("::1", "7878") == "[::1]:7878");
+  for (const char* text : {"tank.example:80", "[::1]:7878", "[fe80::1]:1"}) {
+    const auto parsed = parse_host_port(text);
+    REQUIRE(parsed);
+    CHECK(fishtank::host_port_text(parsed->host, std::to_string(parsed->port)) == text);
+  }
+}

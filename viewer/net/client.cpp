@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstring>
 
+#include "common/host_port.h"
 #include "common/server_hint.h"
 #include "viewer/clock.h"
 
@@ -25,7 +26,7 @@ Vec3 to_vec3(const wire::Vec3f& v) { return {v.x(), v.y(), v.z()}; }
 
 NetClient::NetClient(std::string host, std::string port, bool wants_player, SnapshotBuffer& snapshots)
     : host_(std::move(host)), port_(std::move(port)), wants_player_(wants_player), snapshots_(snapshots) {
-  status_.endpoint = host_ + ":" + port_;
+  status_.endpoint = host_port_text(host_, port_);
   ping_epoch_ = second_started_ = steady_seconds();
   asio::post(io_, [this] {
     do_connect();
