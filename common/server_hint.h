@@ -9,12 +9,14 @@
 
 namespace fishtank {
 
-// "To start a server here: build/server/fishtank-server --port 7913"; for another host, with --bind.
+// "To start a server here: build/server/fishtank-server --port 7913"; with --bind where the server's default
+// address, 127.0.0.1, would not answer: the IPv6 loopback, another host (every address of its IP version).
 inline std::string server_command_hint(const std::string& host, const std::string& port) {
   const std::string server = "build/server/fishtank-server";
-  if (host == "127.0.0.1" || host == "localhost" || host == "::1")
-    return "To start a server here: " + server + " --port " + port;
-  return "To start a server on " + host + ": " + server + " --bind 0.0.0.0 --port " + port;
+  if (host == "127.0.0.1" || host == "localhost") return "To start a server here: " + server + " --port " + port;
+  if (host == "::1") return "To start a server here: " + server + " --bind ::1 --port " + port;
+  const char* every_address = host.find(':') == std::string::npos ? "0.0.0.0" : "::";
+  return "To start a server on " + host + ": " + server + " --bind " + every_address + " --port " + port;
 }
 
 inline constexpr std::string_view kCannotResolve = "cannot resolve ";

@@ -87,6 +87,11 @@ TEST_CASE("while no server answers, the hint is the exact command that starts on
         "To start a server here: build/server/fishtank-server --port 7878");
   CHECK(server_command_hint("otherhost", "7913") ==
         "To start a server on otherhost: build/server/fishtank-server --bind 0.0.0.0 --port 7913");
+  // The server listens on 127.0.0.1 unless told: IPv6 addresses need their own --bind.
+  CHECK(server_command_hint("::1", "7878") ==
+        "To start a server here: build/server/fishtank-server --bind ::1 --port 7878");
+  CHECK(server_command_hint("fe80::1", "7878") ==
+        "To start a server on fe80::1: build/server/fishtank-server --bind :: --port 7878");
 }
 
 TEST_CASE(
