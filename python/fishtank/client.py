@@ -72,6 +72,18 @@ def _whole_number(value, what, lowest):
     return int(value)
 
 
+def _server_command(host, port):
+    """The command that starts a server answering at host:port: it listens on 127.0.0.1 unless given --bind
+    (common/server_hint.h says the same for the viewer)."""
+    if host in ("127.0.0.1", "localhost"):
+        bind = ""
+    elif host == "::1":
+        bind = " --bind ::1"
+    else:
+        bind = " --bind ::" if ":" in host else " --bind 0.0.0.0"
+    return f"build/server/fishtank-server{bind} --port {port}"
+
+
 def _vec(v):
     return np.array([v.X(), v.Y(), v.Z()], dtype=np.float32)
 
@@ -222,7 +234,7 @@ class Client:
             return socket.create_connection((host, port), timeout=self.timeout)
         except ConnectionRefusedError:
             raise FishtankError("cannot_connect", f"nothing listens at {self.address} (connection refused); start a "
-                                f"server there with build/server/fishtank-server --port {port}, or use the port "
+                                f"server there with {_server_command(host, port)}, or use the port "
                                 "its 'listening on' line shows") from None
         except socket.gaierror as e:
             raise FishtankError("cannot_connect", f"cannot resolve {host}: {e.strerror or e}; check the host name, "

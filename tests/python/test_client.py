@@ -149,6 +149,16 @@ def test_a_port_where_nothing_listens_raises_fishtank_error_with_the_address_and
     assert f"build/server/fishtank-server --port {port}" in refused.value.message
 
 
+def test_the_server_command_binds_where_the_default_127_0_0_1_would_not_answer():
+    # The viewer's hint (common/server_hint.h) says the same; a refused connection to another host cannot be
+    # made to happen here, so the command is checked on its own.
+    command = fishtank.client._server_command
+    assert command("localhost", 7878) == "build/server/fishtank-server --port 7878"
+    assert command("::1", 7878) == "build/server/fishtank-server --bind ::1 --port 7878"
+    assert command("tank.example", 7878) == "build/server/fishtank-server --bind 0.0.0.0 --port 7878"
+    assert command("fe80::1", 7878) == "build/server/fishtank-server --bind :: --port 7878"
+
+
 def test_a_port_or_timeout_out_of_range_is_refused_before_any_connection_with_the_range():
     for port in (0, "7878", 7878.0, True):
         with pytest.raises(ValueError, match=r"port must be a whole number of at least 1"):
