@@ -83,6 +83,21 @@ test('the HUD says how the server chose dt: 13 steps per contact from the defaul
   assert.match(await hudText(page), /Step[\d.]+ ms, 13 steps per contact: each collision's e within 0\.005/);
 });
 
+test('the HUD shows the round trip with the decimals the browser clock resolves, as that clock measures itself', async () => {
+  const step = await page.evaluate(() => {
+    let last = performance.now(), smallest = Infinity;
+    for (let i = 0, steps = 0; i < 1e6 && steps < 20; ++i) {
+      const t = performance.now();
+      if (t > last) [smallest, last, steps] = [Math.min(smallest, t - last), t, steps + 1];
+    }
+    return smallest;
+  });
+  const decimals = step >= 0.999 ? 0 : step >= 0.0999 ? 1 : 2;
+  const shown = (await waitForHud(page, (t) => /Round trip[<\d]/.test(t))).match(/Round trip(< )?([\d.]+) ms/);
+  assert.ok(shown, 'a round trip shown');
+  assert.equal(shown[2].split('.')[1]?.length ?? 0, decimals, `${shown[0]} on a clock of ${step} ms steps`);
+});
+
 test('the page decodes delta snapshots against its Acks without asking for a keyframe', async () => {
   const s = await waitForState(page, (st) => st.deltas >= 30, '30 delta snapshots');
   assert.equal(s.keyframeRequests, 0);

@@ -1,7 +1,7 @@
 // The statistics panel and the help overlay, as HTML over the canvas. Figures
 // that came from the server are greyed, with the reason, when the link is down.
 
-import { controlText, freshnessNote, stepText, threadsText, timeScaleText } from './hud_text';
+import { clockStepMs, controlText, freshnessNote, roundTripText, stepText, threadsText, timeScaleText } from './hud_text';
 import type { Connection } from './net';
 
 const HELP: [string, string][] = [
@@ -35,6 +35,7 @@ export interface HudView {
 export class Hud {
   private readonly stats: HTMLElement;
   private readonly help: HTMLElement;
+  private readonly clockStep = clockStepMs();  // round trips are shown no finer than this
 
   constructor(root: HTMLElement) {
     this.stats = document.createElement('div');
@@ -83,7 +84,7 @@ export class Hud {
     row('Snapshots', `${net.snapshotsPerS.toFixed(1)} /s   render delay ${v.renderDelayMs.toFixed(0)} ms`);
     const perBall = s && s.ballCount > 0 && net.snapshotsPerS > 0 ? `, ${(net.bytesPerS / (net.snapshotsPerS * s.ballCount)).toFixed(2)} B per ball` : '';
     row('Bandwidth', `${(net.bytesPerS / 1024).toFixed(1)} KiB/s in${perBall}`);
-    row('Round trip', net.rttMs >= 0 ? `${net.rttMs.toFixed(2)} ms` : '-');
+    row('Round trip', roundTripText(net.rttMs, this.clockStep));
     if (info) {
       row('Player', info.hasPlayer ? 'yours is the white sphere with the amber ring'
         : v.observerAsked ? 'observing, as asked (?observer)' : `observing: ${net.observing || 'the server gave no player sphere'}`);

@@ -1,0 +1,33 @@
+// The page's HUD words (web/src/hud_text.ts, bundled for node by tests/web/CMakeLists.txt): a round trip is
+// shown no finer than the browser's clock can time it, and that clock's step is found by sampling it.
+
+import assert from 'node:assert/strict';
+import { test } from 'node:test';
+import { need } from './harness.mjs';
+
+const { clockStepMs, roundTripText } = await import(need('FISHTANK_WEB_HUD_TEXT_MODULE'));
+
+// A clock that reads `step`-coarsened time and advances `tick` ms per read, like a browser's performance.now().
+const coarseClock = (step, tick = 0.013) => {
+  let t = 1000;
+  return () => Math.floor((t += tick) / step) * step;
+};
+
+test('the clock step is found from the clock itself: 1 ms, 0.1 ms, and 5 µs', () => {
+  assert.equal(clockStepMs(coarseClock(1)), 1);
+  assert.ok(Math.abs(clockStepMs(coarseClock(0.1)) - 0.1) < 1e-6);
+  assert.ok(Math.abs(clockStepMs(coarseClock(0.005, 0.001)) - 0.005) < 1e-6);
+});
+
+test('a clock that never moves while sampled reads as coarse as the sampling', () => {
+  assert.equal(clockStepMs(() => 7, 5), 5);
+});
+
+test('a round trip has only the decimals its clock resolves', () => {
+  assert.equal(roundTripText(3, 1), '3 ms');
+  assert.equal(roundTripText(0, 1), '< 1 ms');  // a 1 ms clock cannot time a sub-millisecond loop
+  assert.equal(roundTripText(0.3000000001, 0.1), '0.3 ms');
+  assert.equal(roundTripText(0.05, 0.1), '< 0.1 ms');
+  assert.equal(roundTripText(0.2345, 0.005), '0.23 ms');
+  assert.equal(roundTripText(-1, 0.1), '-');
+});
