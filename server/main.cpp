@@ -11,12 +11,12 @@
 #include <string>
 
 #include "common/fp_env.h"
+#include "common/output_paths.h"
 #include "common/time_scale.h"
 #include "server/bench/benchmark.h"
 #include "server/bench/scenes.h"
 #include "server/export/csv_dump.h"
 #include "server/export/lammps_export.h"
-#include "server/export/output_paths.h"
 #include "server/export/trajectory_recorder.h"
 #include "server/net/network_service.h"
 #include "server/options.h"

@@ -9,6 +9,7 @@
 
 #include "common/flag_values.h"
 #include "common/host_port.h"
+#include "common/output_paths.h"
 #include "viewer/app.h"
 #include "viewer/frame_pacer.h"
 
@@ -59,6 +60,9 @@ int main(int argc, char** argv) {
   opt.host = address->host;
   opt.port = std::to_string(address->port);
   if (opt.frames < 1) return refuse("--frames must be at least 1, got " + std::to_string(opt.frames));
+  if (!opt.screenshot.empty())
+    if (const std::string why = fishtank::check_writable_file(opt.screenshot); !why.empty())
+      return refuse("--screenshot " + opt.screenshot + ": " + why);
   if (vm.count("max-fps") && (opt.max_fps < 0 || opt.max_fps > fishtank::viewer::FramePacer::kMaxFps))
     return refuse("--max-fps must be between 0 (no cap) and " +
                   std::to_string(fishtank::viewer::FramePacer::kMaxFps) + ", got " +

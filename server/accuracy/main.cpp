@@ -24,12 +24,12 @@
 #include <vector>
 
 #include "common/flag_values.h"
+#include "common/output_paths.h"
 #include "server/accuracy/collisions.h"
 #include "server/accuracy/reference.h"
 #include "server/accuracy/rows.h"
 #include "server/accuracy/stability.h"
 #include "server/accuracy/sweep.h"
-#include "server/export/output_paths.h"
 #include "server/physics/kernels.h"
 #include "server/physics/params.h"
 

@@ -1,6 +1,7 @@
 """Each bad flag of fishtank-viewer is refused before a window opens: exit code 2, the flag and the value given
 on one line, then the pointer to --help; a --connect port that cannot exist is one of them, not an address
-retried every second. No display is needed: the flags are read first."""
+retried every second, and a --screenshot path that cannot be written is another. No display is needed: the flags
+are read first."""
 
 import os
 import subprocess
@@ -20,6 +21,9 @@ VIEWER = os.path.join(os.environ["FISHTANK_BUILD_DIR"], "viewer", "fishtank-view
     (["--max-fps", "-1"], "--max-fps must be between 0 (no cap) and"),
     (["--duration", "-2"], "--duration must be a number of seconds >= 0 (0: stay open), got -2"),
     (["--duration", "soon"], "the argument ('soon') for option '--duration' is invalid"),
+    # Checked before a window opens, not found when the frames are drawn.
+    (["--screenshot", "/nonexistent-folder/shot.png"],
+     "--screenshot /nonexistent-folder/shot.png: the folder /nonexistent-folder does not exist"),
 ])
 def test_a_bad_flag_is_refused_with_what_is_wrong_and_where_help_is(flags, said):
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}

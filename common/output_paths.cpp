@@ -1,4 +1,4 @@
-#include "server/export/output_paths.h"
+#include "common/output_paths.h"
 
 #include <unistd.h>
 

@@ -1,7 +1,7 @@
 #pragma once
-// The final state's files are written when a run ends, which may be an hour
-// after it starts: their paths are checked first, so that a run cannot end in
-// "cannot write" with its result lost.
+// Files written when a run ends (the server's final state, the accuracy tool's CSVs, a viewer's --screenshot),
+// which may be an hour after it starts: their paths are checked first, so that a run cannot end in "cannot
+// write" with its result lost.
 
 #include <string>
 
