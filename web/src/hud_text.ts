@@ -44,8 +44,9 @@ export function controlText(mayControl: boolean, policy: string): string {
   return (mayControl ? 'yours (P O R [ ] 1-4): ' : 'not yours: ') + policy;
 }
 
-// The smallest step performance.now() takes here, sampled for up to forMs (and a bounded number of reads): 0.1 ms
-// in Chromium, 1 ms in Firefox and Safari unless the page is cross-origin isolated.
+// The smallest step performance.now() takes here, sampled for up to forMs (and a bounded number of reads):
+// browsers coarsen it against timing attacks, by 0.1 ms in most pages and up to 1 ms or more in some browsers
+// and privacy settings.
 export function clockStepMs(now: () => number = () => performance.now(), forMs = 5): number {
   let last = now();
   const until = last + forMs;
