@@ -7,6 +7,8 @@
 #include <csignal>
 #include <cstdio>
 
+#include "server/net/machine_addresses.h"
+
 namespace fishtank::net {
 
 namespace {
@@ -19,11 +21,6 @@ double cpu_seconds(clockid_t clock) {
 double thread_cpu_seconds(std::thread& thread) {
   clockid_t clock;
   return pthread_getcpuclockid(thread.native_handle(), &clock) == 0 ? cpu_seconds(clock) : 0.0;
-}
-
-// An address as a URL or --connect writes it: an IPv6 one in brackets ([::1]:7878).
-std::string url_host(const boost::asio::ip::address& address) {
-  return address.is_v6() ? "[" + address.to_string() + "]" : address.to_string();
 }
 
 }  // namespace
@@ -61,12 +58,16 @@ std::string NetworkService::start() {
     const auto web = server_.web_endpoint();
     std::fprintf(stderr, "web viewer on http://%s:%u/\n", url_host(web.address()).c_str(), web.port());
   }
-  // 0.0.0.0 is no address to give a room: name this machine, which the others reach it by.
+  // 0.0.0.0 is no address to give a room: an address of this machine's is (its name, where a name server knows it).
   if (endpoint.address().is_unspecified()) {
-    const std::string name = boost::asio::ip::host_name();
-    std::fprintf(stderr, "from other machines, by this machine's name %s (or its IP address):", name.c_str());
-    if (options_.web) std::fprintf(stderr, " a browser at http://%s:%u/,", name.c_str(), server_.web_endpoint().port());
-    std::fprintf(stderr, " fishtank-viewer --connect %s:%u\n", name.c_str(), endpoint.port());
+    const auto addresses = machine_addresses(endpoint.address().is_v6());
+    std::string known_as = boost::asio::ip::host_name();
+    for (const auto& address : addresses) known_as += ", " + address.to_string();
+    const std::string host = addresses.empty() ? boost::asio::ip::host_name() : url_host(addresses.front());
+    std::fprintf(stderr, "from other machines:");
+    if (options_.web) std::fprintf(stderr, " a browser at http://%s:%u/,", host.c_str(), server_.web_endpoint().port());
+    std::fprintf(stderr, " fishtank-viewer --connect %s:%u (this machine: %s)\n", host.c_str(), endpoint.port(),
+                 known_as.c_str());
   }
   std::fflush(stderr);
   io_thread_ = std::thread([this] { io_.run(); });
