@@ -121,7 +121,10 @@ class Client:
         if not (isinstance(timeout, (int, float)) and timeout > 0):
             raise ValueError(f"timeout must be a positive number of seconds, got {timeout!r}")
         self.timeout = timeout
-        self.address = f"{host}:{port}"
+        # "[::1]" as the server's listening line and --connect write an IPv6 address; the socket wants "::1".
+        if isinstance(host, str) and len(host) > 2 and host[0] == "[" and host[-1] == "]":
+            host = host[1:-1]
+        self.address = f"[{host}]:{port}" if ":" in str(host) else f"{host}:{port}"
         self._sock = self._connect(host, port)
         self._sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         self._buffer = bytearray()

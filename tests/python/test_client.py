@@ -149,6 +149,16 @@ def test_a_port_where_nothing_listens_raises_fishtank_error_with_the_address_and
     assert f"build/server/fishtank-server --port {port}" in refused.value.message
 
 
+def test_an_ipv6_address_in_brackets_as_the_server_writes_it_is_connected_to_not_looked_up_as_a_name():
+    with socket.socket() as probe:  # a port just freed on 127.0.0.1; on ::1 nothing listens there either
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    with pytest.raises(FishtankError) as refused:
+        Client("[::1]", port, timeout=5)
+    assert refused.value.code == "cannot_connect"
+    assert "cannot resolve" not in refused.value.message and f"[::1]:{port}" in refused.value.message
+
+
 def test_the_server_command_binds_where_the_default_127_0_0_1_would_not_answer():
     # The viewer's hint (common/server_hint.h) says the same; a refused connection to another host cannot be
     # made to happen here, so the command is checked on its own.
