@@ -9,7 +9,7 @@ case "${1:-}" in
 esac
 
 # For a script whose only arguments are positional (a build folder, say): refuses an option, or more than
-# $1 arguments, with the usage line, instead of reading "--bogus" as a folder's name.
+# $1 arguments, pointing at --help, instead of reading "--bogus" as a folder's name.
 positional_only() {
   local most=$1
   shift
