@@ -168,6 +168,8 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   if (balls == -1) balls = o.bench ? 6000 : default_balls(o.bench_spec.scene.name);
   if (balls < 0 || balls > 10'000'000)
     return fail("--balls must be between 0 and 10000000, got " + std::to_string(balls));
+  // A rate and a capacity measured on no balls would read as "this build holds none".
+  if (o.bench && balls == 0) return fail("--bench times balls: give --balls 1 or more (or leave it out: 6000)");
   if (threads < 1 || threads > 1024)
     return fail("--threads must be between 1 and 1024, got " + std::to_string(threads));
   if (!threaded && threads != 1)

@@ -199,6 +199,7 @@ TEST_CASE("every bad value is refused with a message naming it and exit code 2",
       {{"--record", "--bench"}, "--record wants a value, got the flag '--bench'"},
       {{"--dump", "--balls", "10"}, "--dump wants a value, got the flag '--balls'"},
       {{"--dt=--x"}, "--dt wants a value, got the flag '--x'"},
+      {{"--bench", "--balls", "0"}, "--bench times balls: give --balls 1 or more"},
   };
   for (const Bad& b : bad) {
     std::string line;
