@@ -1,5 +1,6 @@
 #include "server/options.h"
 
+#include <algorithm>
 #include <boost/program_options.hpp>
 #include <cmath>
 #include <sstream>
@@ -177,6 +178,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   if (seed < 0) return fail("--seed must be >= 0");
   if (steps < 1 || steps > 1'000'000'000)
     return fail("--steps must be between 1 and 1e9, got " + std::to_string(steps));
+  if (vm["windows"].defaulted()) windows = std::min<std::int64_t>(windows, steps);  // --steps 3: three windows
   if (windows < 1 || windows > 1000 || windows > steps)
     return fail("--windows must be between 1 and 1000 and at most --steps, got " + std::to_string(windows));
   if (lammps_steps < 0 || lammps_steps > 1'000'000'000'000)

@@ -105,6 +105,9 @@ TEST_CASE("the wide benchmark's flags give its spec, and a tank widened for the 
   CHECK(o.physics.tank.size().y == 40.0f);
   // Without --balls the benchmark fills the product's tank.
   CHECK(parse({"--bench"}).options->start_balls == 6000);
+  // Fewer steps than the default windows: one window per step, not a refusal of a flag not given.
+  CHECK(parse({"--bench"}).options->bench_spec.windows == 5);
+  CHECK(parse({"--bench", "--steps", "3"}).options->bench_spec.windows == 3);
 }
 
 TEST_CASE(
