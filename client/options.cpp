@@ -15,6 +15,13 @@ namespace po = boost::program_options;
 
 namespace {
 
+// A number as it was typed: 5, not std::to_string's 5.000000.
+std::string got(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
 // "x,y,z" with three finite numbers and nothing else.
 std::optional<Vec3> parse_vec3(const std::string& text) {
   Vec3 v;
@@ -90,29 +97,31 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   if (!address) return fail("--connect wants host:port with a port 1 .. 65535, got '" + connect + "'");
   o.script.host = address->host;
   o.script.port = address->port;
-  if (clients < 1 || clients > 1000) return fail("--clients must be between 1 and 1000");
+  if (clients < 1 || clients > 1000)
+    return fail("--clients must be between 1 and 1000, got " + std::to_string(clients));
   if (add < 0 || add > protocol::kMaxAddBallsPerRequest)
-    return fail("--add must be between 0 and " + std::to_string(protocol::kMaxAddBallsPerRequest));
+    return fail("--add must be between 0 and " + std::to_string(protocol::kMaxAddBallsPerRequest) + ", got " +
+                std::to_string(add));
   if (!vm["move"].empty()) {
     o.script.move = parse_vec3(move);
     if (!o.script.move) return fail("--move wants three finite numbers x,y,z, got '" + move + "'");
     if (o.script.observer) return fail("--move needs a player sphere; drop --observer");
   }
-  if (!std::isfinite(o.script.move_for) || o.script.move_for < 0.0) return fail("--for must be seconds >= 0");
+  if (!std::isfinite(o.script.move_for) || o.script.move_for < 0.0)
+    return fail("--for must be seconds >= 0, got " + got(o.script.move_for));
   if (!std::isfinite(o.script.duration) || o.script.duration <= 0.0 || o.script.duration > 86400.0)
-    return fail("--duration must be between 0 and 86400 seconds");
-  if (!std::isfinite(o.script.every) || o.script.every < 0.0) return fail("--every must be seconds >= 0");
+    return fail("--duration must be more than 0 and at most 86400 seconds, got " + got(o.script.duration));
+  if (!std::isfinite(o.script.every) || o.script.every < 0.0)
+    return fail("--every must be seconds >= 0, got " + got(o.script.every));
   if (pause && resume) return fail("--pause and --resume contradict each other; give one");
   if (step < 0 || step > protocol::kMaxStepsPerRequest)
-    return fail("--step must be between 0 and " + std::to_string(protocol::kMaxStepsPerRequest));
-  if (!vm["time-scale"].empty() && !(time_scale >= protocol::kMinTimeScale && time_scale <= protocol::kMaxTimeScale)) {
-    std::ostringstream got;  // 5, not std::to_string's 5.000000
-    got << time_scale;
-    return fail("--time-scale must be between 0.1 and 1, got " + got.str());
-  }
+    return fail("--step must be between 0 and " + std::to_string(protocol::kMaxStepsPerRequest) + ", got " +
+                std::to_string(step));
+  if (!vm["time-scale"].empty() && !(time_scale >= protocol::kMinTimeScale && time_scale <= protocol::kMaxTimeScale))
+    return fail("--time-scale must be between 0.1 and 1, got " + got(time_scale));
   if (!vm["scene"].empty() && (scene.empty() || scene.size() > protocol::kMaxSceneNameBytes))
     return fail("--scene wants a scene's name (tank, wide, dam-break or drop)");
-  if (!vm["seed"].empty() && seed < 0) return fail("--seed must be >= 0");
+  if (!vm["seed"].empty() && seed < 0) return fail("--seed must be >= 0, got " + std::to_string(seed));
   if (!vm["seed"].empty() && vm["scene"].empty() && !reset) return fail("--seed goes with --reset or --scene");
   if (!vm["scene"].empty()) o.script.scene = scene;
   if (!vm["seed"].empty()) o.script.seed = static_cast<std::uint64_t>(seed);
