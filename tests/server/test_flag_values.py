@@ -1,7 +1,7 @@
-"""A flag given without its value does not take the next flag as the value: each program refuses
-"--record --bench", "--out --quick" and the like with exit code 2, naming both, and writes nothing (the
-server would have recorded into a file named "--bench" and run the daemon). A value with one dash is still
-a value ("--move -2,0,0")."""
+"""A flag given without its value does not take the next flag as the value: each program refuses "--record
+--bench", "--out --quick" and the like with exit code 2, naming both, and writes nothing (the server would
+have recorded into a file named "--bench" and run the daemon). A value with one dash is still a value ("--move
+-2,0,0"). fishtank-client refuses a value out of range with the range and the value given."""
 
 import os
 import subprocess
@@ -34,3 +34,22 @@ def test_a_value_with_one_dash_is_still_a_value(tmp_path):
                           "127.0.0.1:1", "--duration", "0.1"], capture_output=True, text=True, timeout=60)
     assert run.returncode == 1, run.stderr  # past the flags, to the connection
     assert "no connection to 127.0.0.1:1" in run.stderr
+
+
+@pytest.mark.parametrize("flags, said", [
+    (["--clients", "0"], "--clients must be between 1 and 1000, got 0"),
+    (["--add", "-1"], "--add must be between 0 and 100000, got -1"),
+    (["--duration", "0"], "--duration must be more than 0 and at most 86400 seconds, got 0"),
+    (["--for", "nan"], "--for must be seconds >= 0, got nan"),
+    (["--every", "-1"], "--every must be seconds >= 0, got -1"),
+    (["--step", "-2"], "--step must be between 0 and 100000, got -2"),
+    (["--time-scale", "5"], "--time-scale must be between 0.1 and 1, got 5"),
+    (["--reset", "--seed", "-1"], "--seed must be >= 0, got -1"),
+    (["--move", "1,2"], "--move wants three finite numbers x,y,z, got '1,2'"),
+    (["--pause", "--resume"], "--pause and --resume contradict each other; give one"),
+])
+def test_a_client_value_out_of_range_is_refused_with_its_range_and_the_value_given(flags, said):
+    run = subprocess.run([os.path.join(BUILD, "client", "fishtank-client"), *flags], capture_output=True, text=True,
+                         timeout=30)
+    assert run.returncode == 2, run.stderr
+    assert run.stderr.splitlines() == [f"fishtank-client: {said}", "Try --help for the list of options."]
