@@ -7,6 +7,7 @@
 
 #include "common/flag_values.h"
 #include "common/host_port.h"
+#include "common/number_text.h"
 #include "protocol/frame_codec.h"
 
 namespace fishtank::client {
@@ -14,13 +15,6 @@ namespace fishtank::client {
 namespace po = boost::program_options;
 
 namespace {
-
-// A number as it was typed: 5, not std::to_string's 5.000000.
-std::string got(double value) {
-  std::ostringstream text;
-  text << value;
-  return text.str();
-}
 
 // "x,y,z" with three finite numbers and nothing else.
 std::optional<Vec3> parse_vec3(const std::string& text) {
@@ -108,17 +102,17 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
     if (o.script.observer) return fail("--move needs a player sphere; drop --observer");
   }
   if (!std::isfinite(o.script.move_for) || o.script.move_for < 0.0)
-    return fail("--for must be seconds >= 0, got " + got(o.script.move_for));
+    return fail("--for must be seconds >= 0, got " + number_text(o.script.move_for));
   if (!std::isfinite(o.script.duration) || o.script.duration <= 0.0 || o.script.duration > 86400.0)
-    return fail("--duration must be more than 0 and at most 86400 seconds, got " + got(o.script.duration));
+    return fail("--duration must be more than 0 and at most 86400 seconds, got " + number_text(o.script.duration));
   if (!std::isfinite(o.script.every) || o.script.every < 0.0)
-    return fail("--every must be seconds >= 0, got " + got(o.script.every));
+    return fail("--every must be seconds >= 0, got " + number_text(o.script.every));
   if (pause && resume) return fail("--pause and --resume contradict each other; give one");
   if (step < 0 || step > protocol::kMaxStepsPerRequest)
     return fail("--step must be between 0 and " + std::to_string(protocol::kMaxStepsPerRequest) + ", got " +
                 std::to_string(step));
   if (!vm["time-scale"].empty() && !(time_scale >= protocol::kMinTimeScale && time_scale <= protocol::kMaxTimeScale))
-    return fail("--time-scale must be between 0.1 and 1, got " + got(time_scale));
+    return fail("--time-scale must be between 0.1 and 1, got " + number_text(time_scale));
   if (!vm["scene"].empty() && (scene.empty() || scene.size() > protocol::kMaxSceneNameBytes))
     return fail("--scene wants a scene's name (tank, wide, dam-break or drop)");
   if (!vm["seed"].empty() && seed < 0) return fail("--seed must be >= 0, got " + std::to_string(seed));

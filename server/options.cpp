@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "common/flag_values.h"
+#include "common/number_text.h"
 #include "common/scene_names.h"
 #include "server/physics/worker_pool.h"
 #include "server/scenes/scene_presets.h"
@@ -19,14 +20,6 @@ namespace fishtank {
 namespace po = boost::program_options;
 
 namespace {
-
-// A number as the user would have typed it back: "0.5", "1e+10", "nan".
-std::string got(double value) {
-  std::ostringstream text;
-  text << value;
-  return text.str();
-}
-
 std::string scene_help() {
   return "scene to start with, which clients may switch live (also --bench's): " + scene_names_text();
 }
@@ -196,7 +189,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   o.lammps_steps = static_cast<std::uint64_t>(lammps_steps);
   o.record.every = static_cast<std::uint32_t>(record_every);
   if (!std::isfinite(o.record.from) || o.record.from < 0.0 || o.record.from > 1e9)
-    return fail("--record-from must be between 0 and 1e9 simulated seconds, got " + got(o.record.from));
+    return fail("--record-from must be between 0 and 1e9 simulated seconds, got " + number_text(o.record.from));
   if (o.record.path.empty())
     for (const char* flag : {"record-every", "record-from", "record-constant-count"})
       if (!vm[flag].defaulted())
@@ -204,11 +197,11 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   if (max_balls < 0 || max_balls > 10'000'000)
     return fail("--max-balls must be between 0 and 10000000, got " + std::to_string(max_balls));
   if (!std::isfinite(o.duration) || o.duration < 0.0)
-    return fail("--duration must be a number of seconds >= 0, got " + got(o.duration));
+    return fail("--duration must be a number of seconds >= 0, got " + number_text(o.duration));
   if (!std::isfinite(o.status_interval) || o.status_interval < 0.05 || o.status_interval > 3600.0)
-    return fail("--status-interval must be between 0.05 and 3600 seconds, got " + got(o.status_interval));
+    return fail("--status-interval must be between 0.05 and 3600 seconds, got " + number_text(o.status_interval));
   if (!std::isfinite(settle_time) || settle_time < 0.0 || settle_time > 1e6)
-    return fail("--settle-time must be between 0 and 1e6 simulated seconds, got " + got(settle_time));
+    return fail("--settle-time must be between 0 and 1e6 simulated seconds, got " + number_text(settle_time));
   if (steps_per_contact != 0 && (steps_per_contact < PhysicsParams::kMinStepsPerContact || steps_per_contact > 100000))
     return fail("--steps-per-contact must be 0 (from --tolerance) or between " +
                 std::to_string(PhysicsParams::kMinStepsPerContact) + " and 100000, got " +
@@ -222,7 +215,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   if (!no_web && port != 0 && port == web_port)
     return fail("--port and --web-port are both " + std::to_string(port) + "; give them different ports");
   if (!std::isfinite(o.snapshot_rate) || o.snapshot_rate < 1.0 || o.snapshot_rate > 1000.0)
-    return fail("--snapshot-rate must be between 1 and 1000 per second, got " + got(o.snapshot_rate));
+    return fail("--snapshot-rate must be between 1 and 1000 per second, got " + number_text(o.snapshot_rate));
   if (max_players < 0 || max_players > 1000)
     return fail("--max-players must be between 0 and 1000, got " + std::to_string(max_players));
 
@@ -233,15 +226,15 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
     return fail("--max-connections must be between 1 and 100000, got " + std::to_string(max_connections));
   const auto within = [](double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; };
   if (!within(limits.hello_timeout_s, 0.1, 3600.0))
-    return fail("--hello-timeout must be between 0.1 and 3600 seconds, got " + got(limits.hello_timeout_s));
+    return fail("--hello-timeout must be between 0.1 and 3600 seconds, got " + number_text(limits.hello_timeout_s));
   if (!within(limits.idle_timeout_s, 0.1, 86400.0))
-    return fail("--idle-timeout must be between 0.1 and 86400 seconds, got " + got(limits.idle_timeout_s));
+    return fail("--idle-timeout must be between 0.1 and 86400 seconds, got " + number_text(limits.idle_timeout_s));
   if (!within(limits.player_idle_s, 0.0, 86400.0))
-    return fail("--player-idle must be between 0 and 86400 seconds, got " + got(limits.player_idle_s));
+    return fail("--player-idle must be between 0 and 86400 seconds, got " + number_text(limits.player_idle_s));
   if (!within(limits.max_commands_per_s, 1.0, 1e6))
-    return fail("--max-commands must be between 1 and 1000000, got " + got(limits.max_commands_per_s));
+    return fail("--max-commands must be between 1 and 1000000, got " + number_text(limits.max_commands_per_s));
   if (!within(limits.add_balls_per_minute, 0.0, 1e7))
-    return fail("--add-rate must be between 0 and 10000000, got " + got(limits.add_balls_per_minute));
+    return fail("--add-rate must be between 0 and 10000000, got " + number_text(limits.add_balls_per_minute));
   const std::optional<ControlPolicy> rights = parse_control_policy(add_rights);
   if (!rights) return fail("--add-rights must be players, everyone or nobody, got '" + add_rights + "'");
   limits.add_rights = *rights;

@@ -4,11 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
-#include <sstream>
 #include <string>
 
 #include "common/flag_values.h"
 #include "common/host_port.h"
+#include "common/number_text.h"
 #include "common/output_paths.h"
 #include "viewer/app.h"
 #include "viewer/frame_pacer.h"
@@ -67,10 +67,8 @@ int main(int argc, char** argv) {
     return refuse("--max-fps must be between 0 (no cap) and " +
                   std::to_string(fishtank::viewer::FramePacer::kMaxFps) + ", got " +
                   std::to_string(opt.max_fps));
-  if (!std::isfinite(opt.duration) || opt.duration < 0.0 || opt.duration > 1e9) {
-    std::ostringstream got;
-    got << opt.duration;
-    return refuse("--duration must be a number of seconds >= 0 (0: stay open), got " + got.str());
-  }
+  if (!std::isfinite(opt.duration) || opt.duration < 0.0 || opt.duration > 1e9)
+    return refuse("--duration must be a number of seconds >= 0 (0: stay open), got " +
+                  fishtank::number_text(opt.duration));
   return fishtank::viewer::run_viewer(opt);
 }
