@@ -7,7 +7,7 @@ import { execFileSync } from 'node:child_process';
 import { test } from 'node:test';
 import { need } from './harness.mjs';
 
-const { decodePositionsDelta } = await import(need('FISHTANK_WEB_DELTA_MODULE'));
+const { decodePositionsDelta } = await import(need('FISHTANK_WEB_MODULE'));
 const cases = execFileSync(need('FISHTANK_DELTA_VECTORS')).toString().trim().split('\n').map((l) => JSON.parse(l));
 
 const kept = (tick, values) => (values.length ? { tick, positions: Uint16Array.from(values) } : null);

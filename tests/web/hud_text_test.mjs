@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 import { test } from 'node:test';
 import { need } from './harness.mjs';
 
-const { clockStepMs, roundTripText } = await import(need('FISHTANK_WEB_HUD_TEXT_MODULE'));
+const { clockStepMs, roundTripText } = await import(need('FISHTANK_WEB_MODULE'));
 
 // A clock that reads `step`-coarsened time and advances `tick` ms per read, like a browser's performance.now().
 const coarseClock = (step, tick = 0.013) => {
