@@ -94,7 +94,7 @@ void Hud::stats(const HudView& v) {
     row(live, "Time", "%s", time_scale_text(s->time_scale, s->time_scale_set, s->paused).c_str());
     row(live, "Scene", "%s (start %u)", s->scene.empty() ? "-" : s->scene.c_str(), s->scene_start);
     row(live, "Balls", "%u", s->ball_count);
-    const OverlapText overlap = overlap_text(s->max_overlap);
+    const OverlapText overlap = overlap_text(s->max_overlap, s->kinetic_energy_per_ball);
     if (overlap.warn && live) {
       ImGui::TextColored(kDim, "Overlap");
       ImGui::SameLine(110.0f);

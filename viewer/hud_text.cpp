@@ -27,9 +27,9 @@ std::string threads_text(std::uint32_t stepping, int available) {
   return text;
 }
 
-OverlapText overlap_text(float fraction) {
+OverlapText overlap_text(float fraction, float energy_per_ball) {
   char text[96];
-  const bool warn = overlap_too_deep(fraction);
+  const bool warn = resting_overlap_too_deep(fraction, energy_per_ball);
   std::snprintf(text, sizeof text, "%.1f %% of the smaller radius%s", 100.0 * fraction,
                 warn ? ": stiffness too soft for the load" : "");
   return {text, warn};

@@ -27,12 +27,13 @@ std::string threads_text(std::uint32_t stepping, int available);
 std::string time_scale_text(float time_scale, float time_scale_set = 1.0f, bool paused = false);
 
 // The largest overlap (Snapshot.max_overlap, a fraction of the smaller radius):
-// "4.2 % of the smaller radius", and whether it is deep enough to warn about.
+// "4.2 % of the smaller radius", and whether to warn about it: deep while the
+// balls rest (Snapshot.kinetic_energy_per_ball, common/overlap.h), not an impact's.
 struct OverlapText {
   std::string text;
   bool warn = false;
 };
-OverlapText overlap_text(float fraction);
+OverlapText overlap_text(float fraction, float energy_per_ball);
 
 // How the server chose its time step: "1.08 ms, 13 steps per contact: each
 // collision's e within 0.005"; "0.70 ms (given), 20.0 steps per contact" when

@@ -7,11 +7,6 @@
 
 namespace fishtank {
 
-namespace {
-// Kinetic energy per ball below which an overlap is a resting one (J): a unit ball at 0.1 m/s.
-constexpr double kRestingEnergyPerBall = 5e-3;
-}  // namespace
-
 double ball_energy(const Float4& pos, const Float4& vel, float gravity) {
   const double speed2 = double(vel.x) * vel.x + double(vel.y) * vel.y + double(vel.z) * vel.z;
   return 0.5 * vel.w * speed2 + double(vel.w) * gravity * pos.y;
@@ -73,7 +68,8 @@ double elastic_energy(const World& world) {
 
 std::string overlap_warning(const World& world) {
   const float overlap = max_overlap_fraction(world);
-  if (!overlap_too_deep(overlap) || kinetic_energy(world) > kRestingEnergyPerBall * world.ball_count()) return "";
+  const double energy_per_ball = world.ball_count() ? kinetic_energy(world) / world.ball_count() : 0.0;
+  if (!resting_overlap_too_deep(overlap, energy_per_ball)) return "";
   char text[160];
   std::snprintf(text, sizeof text,
                 "largest resting overlap %.0f %% of the smaller radius (over %.0f %%): k = %g N/m is too soft",

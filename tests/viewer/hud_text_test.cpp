@@ -12,13 +12,21 @@ using fishtank::connection_advice;
 using fishtank::server_command_hint;
 
 TEST_CASE("an overlap beyond a tenth of the smaller radius is a warning, a lighter one a plain figure") {
-  const OverlapText light = overlap_text(0.042f);
+  const float resting = 1e-4f;  // J per ball
+  const OverlapText light = overlap_text(0.042f, resting);
   CHECK(light.text == "4.2 % of the smaller radius");
   CHECK_FALSE(light.warn);
-  CHECK_FALSE(overlap_text(0.10f).warn);  // the limit itself is still accepted
-  const OverlapText deep = overlap_text(0.52f);
+  CHECK_FALSE(overlap_text(0.10f, resting).warn);  // the limit itself is still accepted
+  const OverlapText deep = overlap_text(0.52f, resting);
   CHECK(deep.warn);
   CHECK(deep.text == "52.0 % of the smaller radius: stiffness too soft for the load");
+}
+
+TEST_CASE("while balls still fly in, a deep overlap is an impact's: a plain figure, not a warning") {
+  const OverlapText pour = overlap_text(0.184f, 191.0f);  // the default pour two seconds in
+  CHECK_FALSE(pour.warn);
+  CHECK(pour.text == "18.4 % of the smaller radius");
+  CHECK(overlap_text(0.184f, 5e-3f).warn);  // the same overlap once they rest
 }
 
 TEST_CASE("the step row says how dt was chosen: from the tolerance, given, or not said") {
