@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdlib>
 
+#include "common/printable_text.h"
 #include "protocol/quantize.h"
 
 namespace fishtank::client {
@@ -88,7 +89,7 @@ void Connection::handle(const wire::Message& message) {
       tank_.min = {w.tank_min()->x(), w.tank_min()->y(), w.tank_min()->z()};
       tank_.max = {w.tank_max()->x(), w.tank_max()->y(), w.tank_max()->z()};
       may_control_ = w.may_control();
-      control_policy_ = w.control_policy() ? w.control_policy()->str() : std::string();
+      control_policy_ = w.control_policy() ? server_text(w.control_policy()->str()) : std::string();
       break;
     }
     case wire::Payload::BallKinds: {
@@ -109,7 +110,7 @@ void Connection::handle(const wire::Message& message) {
       // A code newer than this client has no name here: its number instead.
       const char* name = wire::EnumNameErrorCode(e.code());
       stats_.error_codes.push_back(*name ? name : std::to_string(static_cast<int>(e.code())));
-      stats_.errors.push_back(stats_.error_codes.back() + ": " + e.message()->str());
+      stats_.errors.push_back(stats_.error_codes.back() + ": " + server_text(e.message()->str()));
       break;
     }
     case wire::Payload::Pong: {
@@ -145,7 +146,7 @@ void Connection::on_snapshot(const wire::Snapshot& s) {
   view_.physics_steps = s.physics_steps();
   view_.paused = s.paused();
   view_.time_scale_set = s.time_scale_set();
-  view_.scene = s.scene() ? s.scene()->str() : std::string();
+  view_.scene = s.scene() ? server_text(s.scene()->str()) : std::string();
   if (s.scene_start() != view_.scene_start) view_.positions.clear();  // other balls: nothing to compare
   view_.scene_start = s.scene_start();
   view_.kinetic_energy_per_ball = s.kinetic_energy_per_ball();

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "common/printable_text.h"
 #include "common/scene_names.h"
 
 namespace fishtank::net {
@@ -95,24 +96,8 @@ Outcome ClientProtocol::on_frame(const std::uint8_t* frame, std::size_t size, Cl
   return on_message(*decoded.message, now);
 }
 
-std::string printable_name(const std::string& raw) {
-  std::string name;
-  for (std::size_t i = 0; i < raw.size() && i < kMaxNameBytes; ++i) {
-    const auto c = static_cast<unsigned char>(raw[i]);
-    if (c >= 0x20 && c < 0x7f && c != '\\') {
-      name += static_cast<char>(c);
-    } else {
-      char escaped[5];
-      std::snprintf(escaped, sizeof escaped, "\\x%02x", c);
-      name += escaped;
-    }
-  }
-  if (raw.size() > kMaxNameBytes) name += "...";
-  return name;
-}
-
 Outcome ClientProtocol::on_hello(const wire::Hello& hello) {
-  if (hello.client_name()) name_ = printable_name(hello.client_name()->str());
+  if (hello.client_name()) name_ = printable_text(hello.client_name()->str(), kMaxNameBytes);
   if (hello.protocol_version() != protocol::kProtocolVersion)
     return refuse(wire::ErrorCode::version_mismatch,
                   "this server speaks protocol version " + std::to_string(protocol::kProtocolVersion) +
@@ -178,7 +163,8 @@ Outcome ClientProtocol::on_control(const wire::Message& message) {
         reset.scene = r.scene()->str();
         if (!is_scene_name(*reset.scene))
           return refuse(wire::ErrorCode::invalid_value,
-                        "unknown scene '" + printable_name(*reset.scene) + "'; the scenes are " + scene_names_text(),
+                        "unknown scene '" + printable_text(*reset.scene, kMaxNameBytes) + "'; the scenes are " +
+                            scene_names_text(),
                         /*disconnect=*/false);
       }
       if (r.seed()) reset.seed = *r.seed();

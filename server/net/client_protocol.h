@@ -46,9 +46,7 @@ struct Outcome {
   std::string log;                       // worth a line in the server log when not empty
 };
 
-// A peer's name as it may be written to the log: control and non-ASCII bytes
-// as \xNN, so that a name cannot forge a line, cut to kMaxNameBytes.
-std::string printable_name(const std::string& raw);
+// A peer's name as the log writes it (common/printable_text.h) is cut to this.
 inline constexpr std::size_t kMaxNameBytes = 64;
 
 // A Hello is a few dozen bytes: before it, a peer may announce no more than

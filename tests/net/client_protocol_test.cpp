@@ -6,6 +6,8 @@
 #include <catch2/catch.hpp>
 #include <string>
 
+#include "common/printable_text.h"
+
 using namespace fishtank;
 
 TEST_CASE("a client name with a newline or an escape code is logged escaped and cut short", "[net]") {
@@ -19,9 +21,9 @@ TEST_CASE("a client name with a newline or an escape code is logged escaped and 
   CHECK(name.find('\n') == std::string::npos);
   CHECK(name.find('\x1b') == std::string::npos);
 
-  CHECK(net::printable_name(std::string(1000, 'a')) == std::string(net::kMaxNameBytes, 'a') + "...");
-  CHECK(net::printable_name("back\\slash") == "back\\x5cslash");  // an escape cannot be faked either
-  CHECK(net::printable_name("caf\xc3\xa9") == "caf\\xc3\\xa9");
+  CHECK(printable_text(std::string(1000, 'a'), net::kMaxNameBytes) == std::string(net::kMaxNameBytes, 'a') + "...");
+  CHECK(printable_text("back\\slash", 10) == "back\\x5cslash");  // an escape cannot be faked either
+  CHECK(printable_text("caf\xc3\xa9", 10) == "caf\\xc3\\xa9");
 }
 
 TEST_CASE("before Hello a peer may announce 1 KiB at most, after it the general cap holds", "[net]") {

@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "common/host_port.h"
+#include "common/printable_text.h"
 #include "common/server_hint.h"
 #include "viewer/clock.h"
 
@@ -176,7 +177,7 @@ void NetClient::on_frame() {
       return on_snapshot(*m.payload_as_Snapshot());
     case wire::Payload::Error: {
       const wire::Error& e = *m.payload_as_Error();
-      std::string text = e.message() ? e.message()->str() : std::string(wire::EnumNameErrorCode(e.code()));
+      std::string text = server_text(e.message()->str());  // present: decode_frame checks
       return update_status([&](ConnectionStatus& s) {
         s.notice = "server: " + text;
         s.notice_time = steady_seconds();
@@ -197,8 +198,8 @@ void NetClient::on_welcome(const wire::Welcome& w) {
     return lose("the server speaks protocol " + std::to_string(w.protocol_version()) + ", this viewer " +
                 std::to_string(protocol::kProtocolVersion));
   auto info = std::make_shared<ServerInfo>();
-  info->variant = w.server_variant() ? w.server_variant()->str() : "?";
-  info->simd = w.simd_level() ? w.simd_level()->str() : "?";
+  info->variant = server_text(w.server_variant()->str());  // present: decode_frame checks
+  info->simd = server_text(w.simd_level()->str());
   info->threads = static_cast<int>(w.worker_threads());
   info->tank = {to_vec3(*w.tank_min()), to_vec3(*w.tank_max())};  // present: decode_frame checks
   info->dt = w.dt();
@@ -209,7 +210,8 @@ void NetClient::on_welcome(const wire::Welcome& w) {
   info->client_id = w.client_id();
   info->has_player = w.has_player();
   info->player_id = w.player_id();
-  info->control_policy = w.control_policy() ? w.control_policy()->str() : "not stated by the server";
+  info->control_policy =
+      w.control_policy() ? server_text(w.control_policy()->str()) : "not stated by the server";
   info->may_control = w.may_control();
   info_ = info;
   kinds_ = std::make_shared<std::vector<std::uint8_t>>();
@@ -258,7 +260,7 @@ void NetClient::on_snapshot(const wire::Snapshot& s) {
   snap->time_scale = s.time_scale();
   snap->paused = s.paused();
   snap->time_scale_set = s.time_scale_set();
-  snap->scene = s.scene() ? s.scene()->str() : std::string();
+  snap->scene = s.scene() ? server_text(s.scene()->str()) : std::string();
   snap->scene_start = s.scene_start();
   snap->kinetic_energy_per_ball = s.kinetic_energy_per_ball();
   snap->contacts = s.contacts();
