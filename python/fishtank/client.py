@@ -95,6 +95,11 @@ def dequantize(q, lo, hi):
     return lo + q.astype(np.float32) * step
 
 
+def _text(raw):
+    """A server's words as str: bytes that are not UTF-8 (a foreign server's) as \\xNN instead of an exception."""
+    return (raw or b"").decode(errors="backslashreplace")
+
+
 def _frame(payload_type, build):
     b = flatbuffers.Builder(128)
     payload = build(b)
@@ -146,7 +151,7 @@ class Client:
         self.steps_per_contact = w.StepsPerContact()  # contact duration of the lightest pair / dt
         self.tolerance = w.Tolerance()  # the per-collision error dt was chosen for; 0: dt given
         self.may_control = w.MayControl()
-        self.control_policy = (w.ControlPolicy() or b"").decode()
+        self.control_policy = _text(w.ControlPolicy())
         self.kinds = [(w.BallKinds(k).Diameter(), w.BallKinds(k).Mass()) for k in range(w.BallKindsLength())]
         self._tank = (_vec(w.TankMin()), _vec(w.TankMax()))
 
@@ -405,7 +410,7 @@ class Client:
         elif kind == Payload.Payload.Error:
             e = Error.Error()
             e.Init(table.Bytes, table.Pos)
-            error = FishtankError(_ERROR_NAMES.get(e.Code(), str(e.Code())), (e.Message() or b"").decode())
+            error = FishtankError(_ERROR_NAMES.get(e.Code(), str(e.Code())), _text(e.Message()))
             self.errors.append(error)
             if self.welcome is None:
                 raise error
@@ -433,7 +438,7 @@ class Client:
             sim_time=s.SimTime(),
             physics_steps=s.PhysicsSteps(),
             paused=s.Paused(),
-            scene=(s.Scene() or b"").decode(),
+            scene=_text(s.Scene()),
             scene_start=s.SceneStart(),
             time_scale=s.TimeScale(),
             time_scale_set=s.TimeScaleSet(),

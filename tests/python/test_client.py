@@ -9,6 +9,7 @@ import socket
 import stat
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -234,6 +235,49 @@ def test_a_peer_that_never_answers_raises_fishtank_error_timeout_with_the_addres
         assert time.monotonic() - started < 5
     assert waited.value.code == "timeout"
     assert f"127.0.0.1:{port}" in waited.value.message and "timeout=" in waited.value.message
+
+
+def _foreign_server(*frames):
+    """A server that is not ours: it sends these frames to the first peer, then waits for it to leave."""
+    listener = socket.create_server(("127.0.0.1", 0))
+
+    def serve():
+        peer, _ = listener.accept()
+        with peer:
+            peer.sendall(b"".join(frames))
+            while peer.recv(4096):
+                pass
+        listener.close()
+
+    threading.Thread(target=serve, daemon=True).start()
+    return listener.getsockname()[1]
+
+
+def test_a_foreign_servers_bytes_that_are_not_utf8_arrive_escaped_not_as_a_decode_error():
+    from fishtank.client import _frame
+    from fishtank.wire import Error, Payload, Vec3f, Welcome
+
+    def welcome(b):
+        policy = b.CreateString(b"nobody \xff controls")
+        Welcome.Start(b)
+        Welcome.AddTankMin(b, Vec3f.CreateVec3f(b, -1, 0, -1))
+        Welcome.AddTankMax(b, Vec3f.CreateVec3f(b, 1, 2, 1))
+        Welcome.AddDt(b, 1e-3)
+        Welcome.AddControlPolicy(b, policy)
+        return Welcome.End(b)
+
+    def error(b):
+        message = b.CreateString(b"refused \xfe\xc3")
+        Error.Start(b)
+        Error.AddCode(b, 3)
+        Error.AddMessage(b, message)
+        return Error.End(b)
+
+    with Client("127.0.0.1", _foreign_server(_frame(Payload.Payload.Welcome, welcome)), timeout=5) as c:
+        assert c.control_policy == "nobody \\xff controls"
+    with pytest.raises(FishtankError) as refused:  # an Error before the Welcome is raised by the constructor
+        Client("127.0.0.1", _foreign_server(_frame(Payload.Payload.Error, error)), timeout=5)
+    assert refused.value.message == "refused \\xfe\\xc3"
 
 
 def test_add_balls_beyond_the_rate_limit_says_rate_limited_before_the_tank_is_full(start_server):
