@@ -5,10 +5,36 @@
 #include <netinet/in.h>
 
 #include <algorithm>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/udp.hpp>
 
 namespace fishtank::net {
 
 namespace ip = boost::asio::ip;
+
+namespace {
+
+// The address this machine sends from on its default route: a UDP socket's connect asks the routing table and
+// sends nothing. Unspecified where there is no default route (a machine on no network, or IPv6 unrouted).
+ip::address default_route_address(bool v6) {
+  boost::asio::io_context io;
+  ip::udp::socket probe(io);
+  boost::system::error_code ec;
+  // A public resolver's address: outside any network of this machine's, so the default route decides. (The
+  // documentation ranges will not do: labs and virtual machines number their own networks from them.)
+  probe.connect({ip::make_address(v6 ? "2001:4860:4860::8888" : "8.8.8.8"), 53}, ec);
+  if (ec) return {};
+  const ip::address local = probe.local_endpoint(ec).address();
+  return ec ? ip::address() : local;
+}
+
+}  // namespace
+
+std::vector<ip::address> put_first(std::vector<ip::address> addresses, const ip::address& first) {
+  const auto found = std::find(addresses.begin(), addresses.end(), first);
+  if (found != addresses.end()) std::rotate(addresses.begin(), found, found + 1);
+  return addresses;
+}
 
 std::vector<ip::address> machine_addresses(bool with_v6) {
   std::vector<ip::address> v4, v6;
@@ -27,6 +53,8 @@ std::vector<ip::address> machine_addresses(bool with_v6) {
     }
   }
   freeifaddrs(list);
+  v4 = put_first(std::move(v4), default_route_address(false));
+  v6 = put_first(std::move(v6), default_route_address(true));
   v4.insert(v4.end(), v6.begin(), v6.end());
   return v4;
 }
