@@ -20,7 +20,14 @@ test('the clock step is found from the clock itself: 1 ms, 0.1 ms, and 5 µs', (
 });
 
 test('a clock that never moves while sampled reads as coarse as the sampling', () => {
-  assert.equal(clockStepMs(() => 7, 5), 5);
+  assert.equal(clockStepMs(() => 7, 10, 5), 5);
+});
+
+test('the page losing the processor for 12 ms while sampling does not read as a 12 ms clock', () => {
+  const clock = coarseClock(0.1);
+  let reads = 0;
+  const preempted = () => clock() + (++reads > 3 ? 12 : 0);  // descheduled after the third read
+  assert.ok(Math.abs(clockStepMs(preempted) - 0.1) < 1e-6);
 });
 
 test('a round trip has only the decimals its clock resolves', () => {

@@ -44,17 +44,19 @@ export function controlText(mayControl: boolean, policy: string): string {
   return (mayControl ? 'yours (P O R [ ] 1-4): ' : 'not yours: ') + policy;
 }
 
-// The smallest step performance.now() takes here, sampled for up to forMs (and a bounded number of reads):
-// browsers coarsen it against timing attacks, by 0.1 ms in most pages and up to 1 ms or more in some browsers
-// and privacy settings.
-export function clockStepMs(now: () => number = () => performance.now(), forMs = 5): number {
+// The smallest step performance.now() takes here, over `increments` of its steps (at most forMs, and a bounded
+// number of reads): browsers coarsen it against timing attacks, by 0.1 ms in most pages and up to 1 ms or more in
+// some browsers and privacy settings. Several steps, not a fixed time: on a busy machine the page may lose the
+// processor for longer than a short window, which would read as one coarse step.
+export function clockStepMs(now: () => number = () => performance.now(), increments = 10, forMs = 50): number {
   let last = now();
   const until = last + forMs;
   let step = Infinity;
-  for (let reads = 0, t = now(); t < until && reads < 1e6; t = now(), ++reads) {
+  for (let reads = 0, seen = 0, t = now(); t < until && seen < increments && reads < 1e7; t = now(), ++reads) {
     if (t > last) {
       step = Math.min(step, t - last);
       last = t;
+      ++seen;
     }
   }
   return Number.isFinite(step) ? step : forMs;
