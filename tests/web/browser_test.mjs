@@ -121,6 +121,51 @@ test('holding D moves the player sphere to the camera\'s right (+x at the start)
   assert.ok(Math.abs(moved.pos[2] - start.pos[2]) < 0.5, `not along z: ${JSON.stringify([start, moved])}`);
 });
 
+test('on a touch screen a pad appears at the first touch: a pinch zooms, the stick moves the sphere forward, +1000 pours balls', async () => {
+  const phone = await browser.newPage();
+  phone.on('pageerror', (e) => pageErrors.push(String(e)));
+  await phone.setViewport({ width: 420, height: 640, hasTouch: true, isMobile: true });
+  await phone.goto(server.url);
+  const s0 = await waitForState(phone, (st) => st.connection === 'connected' && own(st), 'the phone\'s player');
+  assert.equal(s0.touchPadShown, false, 'no pad before a touch: a mouse user never sees it');
+  await phone.touchscreen.tap(210, 200);
+  await waitForState(phone, (st) => st.touchPadShown, 'the pad shown after a touch');
+
+  const far = s0.cameraDistance;
+  const a = await phone.touchscreen.touchStart(180, 300);
+  const b = await phone.touchscreen.touchStart(240, 300);
+  for (let spread = 1; spread <= 4; ++spread) {  // the fingers 60 px apart, then 180: a third of the distance
+    await a.move(180 - 15 * spread, 300);
+    await b.move(240 + 15 * spread, 300);
+  }
+  await a.end();
+  await b.end();
+  const near = (await waitForState(phone, (st) => st.cameraDistance < 0.5 * far, 'the camera pinched nearer')).cameraDistance;
+  assert.ok(Math.abs(near / far - 1 / 3) < 0.05, `spread x3, distance ${far} -> ${near}`);
+
+  // The stick pushed to its top edge: forward, away from the camera, -z at the start.
+  const stick = await phone.$eval('.touchpad .stick', (e) => JSON.parse(JSON.stringify(e.getBoundingClientRect())));
+  const [cx, cy] = [stick.x + stick.width / 2, stick.y + stick.height / 2];
+  const start = own(await waitForState(phone, (st) => own(st), 'the phone\'s player'));
+  const finger = await phone.touchscreen.touchStart(cx, cy);
+  await finger.move(cx, stick.y + 2);
+  try {
+    const moved = own(await waitForState(phone, (st) => own(st).pos[2] < start.pos[2] - 2, 'the player moved 2 m along -z'));
+    assert.ok(Math.abs(moved.pos[0] - start.pos[0]) < 0.5, `not along x: ${JSON.stringify([start, moved])}`);
+  } finally {
+    await finger.end();
+  }
+
+  const before = (await waitForState(phone, (st) => st.serverBalls > 0, 'a snapshot')).serverBalls;
+  const add = await phone.$$eval('.touchpad button', (bs) => {
+    const r = bs.find((b) => b.textContent === '+1000').getBoundingClientRect();
+    return [r.x + r.width / 2, r.y + r.height / 2];
+  });
+  await phone.touchscreen.tap(add[0], add[1]);
+  await waitForState(phone, (st) => st.serverBalls >= before + 1000, `${before + 1000} balls`);
+  await phone.close();
+});
+
 test('two tabs see one world: each sees the other\'s player, and one tab\'s move in the other', async () => {
   const second = await openPage();
   const s2 = await waitForState(second, (st) => st.connection === 'connected' && own(st), 'the second tab\'s player');

@@ -8,6 +8,7 @@ export type Mat4 = Float32Array;  // column-major, as WebGL takes it
 const FOV_Y = Math.PI / 4;
 const ORBIT_RADIANS_PER_PIXEL = 0.005;
 const MAX_PITCH = 1.5;  // just short of straight down, where lookAt degenerates
+export const ZOOM_PER_STEP = 0.9;  // the distance's factor per wheel step (or its worth of a pinch)
 
 const sub = (a: Vec3, b: Vec3): Vec3 => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
 const dot = (a: Vec3, b: Vec3): number => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -69,7 +70,11 @@ export class OrbitCamera {
   }
 
   zoom(wheelSteps: number): void {
-    this.distance = Math.min(this.maxDistance, Math.max(this.minDistance, this.distance * 0.9 ** wheelSteps));
+    this.distance = Math.min(this.maxDistance, Math.max(this.minDistance, this.distance * ZOOM_PER_STEP ** wheelSteps));
+  }
+
+  distanceToTarget(): number {
+    return this.distance;
   }
 
   eye(): Vec3 {

@@ -1,10 +1,11 @@
-// Keys and mouse (viewer/input.h, viewer/sandbox_controls.h): held keys become
-// the player's velocity, key presses one-shot actions, a drag orbits the
-// camera and the wheel zooms.
+// Keys, mouse and touch (viewer/input.h, viewer/sandbox_controls.h): held keys
+// or the touch pad's stick become the player's velocity, key presses and pad
+// buttons one-shot actions; a drag orbits the camera, the wheel or a pinch zooms.
 
 import type { OrbitCamera, Vec3 } from './camera';
-import { normalize } from './camera';
+import { normalize, ZOOM_PER_STEP } from './camera';
 import type { Frame } from './snapshots';
+import { TouchPad } from './touch_pad';
 import * as wire from './wire';
 
 // The scene presets in the order keys 1-4 choose them (common/scene_names.h).
@@ -56,6 +57,8 @@ export function sandboxFrames(a: Actions, newest: Frame | null): Uint8Array[] {
 export class Input {
   private pending = noActions();
   private readonly held = new Set<string>();
+  private readonly pad: TouchPad;
+  private readonly touches = new Map<number, [number, number]>();  // on the canvas, by pointer id
   private dragging = false;
   private lastX = 0;
   private lastY = 0;
@@ -63,7 +66,12 @@ export class Input {
   private dy = 0;
   private wheel = 0;
 
-  constructor(canvas: HTMLCanvasElement) {
+  constructor(canvas: HTMLCanvasElement, overlay: HTMLElement) {
+    this.pad = new TouchPad(overlay, (b) => {
+      if (b === 'addBalls') this.pending.addBalls = true;
+      else if (b === 'help') this.pending.toggleHelp = true;
+      else this.pending.toggleHud = true;
+    });
     window.addEventListener('keydown', (e) => {
       if (e.ctrlKey || e.metaKey || e.altKey) return;  // the browser's shortcuts (Ctrl+R reloads, not resets)
       this.held.add(e.code);
@@ -72,19 +80,29 @@ export class Input {
     window.addEventListener('keyup', (e) => this.held.delete(e.code));
     window.addEventListener('blur', () => this.held.clear());  // keys released elsewhere never send keyup here
     canvas.addEventListener('pointerdown', (e) => {
-      this.dragging = e.button === 0;
+      if (e.pointerType === 'touch') {
+        this.pad.show();
+        this.touches.set(e.pointerId, [e.clientX, e.clientY]);
+      }
+      this.dragging = e.button === 0 && this.touches.size <= 1;  // a second finger pinches instead
       this.lastX = e.clientX;
       this.lastY = e.clientY;
       canvas.setPointerCapture(e.pointerId);
     });
     canvas.addEventListener('pointermove', (e) => {
+      if (this.touches.has(e.pointerId) && this.touches.size === 2) return this.pinch(e);
       if (!this.dragging) return;
       this.dx += e.clientX - this.lastX;
       this.dy += e.clientY - this.lastY;
       this.lastX = e.clientX;
       this.lastY = e.clientY;
     });
-    canvas.addEventListener('pointerup', () => (this.dragging = false));
+    for (const end of ['pointerup', 'pointercancel'] as const) {
+      canvas.addEventListener(end, (e) => {
+        this.touches.delete(e.pointerId);
+        this.dragging = false;  // after a pinch, the finger left does not orbit until it lifts
+      });
+    }
     canvas.addEventListener('wheel', (e) => {
       this.wheel += e.deltaY < 0 ? 1 : -1;
       e.preventDefault();
@@ -97,26 +115,35 @@ export class Input {
     return a;
   }
 
-  // Unit direction (or zero) from the held keys, relative to the camera on the
-  // ground plane: W/S forward/back, A/D left/right, E or Space up, Q or Shift down.
+  // Direction, relative to the camera on the ground plane: W/S forward/back, A/D
+  // left/right, E or Space up, Q or Shift down; or the touch pad's, as far as its
+  // stick is pushed. At most unit length: diagonals no faster than straight moves.
   movement(camera: OrbitCamera): Vec3 {
+    const key = (...codes: string[]): number => (codes.some((c) => this.held.has(c)) ? 1 : 0);
+    const [padRight, padUp, padForward] = this.pad.direction();
+    const right = key('KeyD') - key('KeyA') + padRight;
+    const up = key('KeyE', 'Space') - key('KeyQ', 'ShiftLeft', 'ShiftRight') + padUp;
+    const forward = key('KeyW') - key('KeyS') + padForward;
     const f = camera.forwardOnGround();
     const r = camera.rightOnGround();
-    const d: Vec3 = [0, 0, 0];
-    const add = (v: Vec3, sign: number): void => v.forEach((c, i) => (d[i] += sign * c));
-    if (this.held.has('KeyW')) add(f, 1);
-    if (this.held.has('KeyS')) add(f, -1);
-    if (this.held.has('KeyD')) add(r, 1);
-    if (this.held.has('KeyA')) add(r, -1);
-    if (this.held.has('KeyE') || this.held.has('Space')) d[1] += 1;
-    if (this.held.has('KeyQ') || this.held.has('ShiftLeft') || this.held.has('ShiftRight')) d[1] -= 1;
-    return normalize(d);  // diagonals no faster than straight moves
+    const d: Vec3 = [forward * f[0] + right * r[0], up, forward * f[2] + right * r[2]];
+    return Math.hypot(...d) > 1 ? normalize(d) : d;
   }
 
   driveCamera(camera: OrbitCamera): void {
     if (this.dx || this.dy) camera.orbit(this.dx, this.dy);
     if (this.wheel) camera.zoom(this.wheel);
     this.dx = this.dy = this.wheel = 0;
+  }
+
+  // Two fingers apart or together: the camera's distance in the ratio of their spread, in wheel steps.
+  private pinch(e: PointerEvent): void {
+    const [a, b] = [...this.touches.values()];
+    const before = Math.hypot(a[0] - b[0], a[1] - b[1]);
+    this.touches.set(e.pointerId, [e.clientX, e.clientY]);
+    const [c, d] = [...this.touches.values()];
+    const after = Math.hypot(c[0] - d[0], c[1] - d[1]);
+    if (before > 0 && after > 0) this.wheel += Math.log(after / before) / -Math.log(ZOOM_PER_STEP);
   }
 
   // True when the key is one of ours (the browser's default is then suppressed).

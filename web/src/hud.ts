@@ -21,6 +21,8 @@ const HELP: [string, string][] = [
   ['T', 'show / hide the tank\'s edges'],
   ['F1', 'show / hide the statistics'],
   ['H', 'show / hide this help'],
+  ['Touch', 'drag: orbit; pinch: zoom; the stick moves your sphere, ▲ ▼ raise and lower it,'],
+  ['', '+1000, HUD and ? stand for B, F1 and H'],
 ];
 
 export interface HudView {

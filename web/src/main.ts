@@ -24,11 +24,12 @@ const canvas = document.getElementById('view') as HTMLCanvasElement;
 const gl = canvas.getContext('webgl2', { antialias: true });
 const renderer = gl ? new Renderer(gl) : null;
 const webglProblem = gl ? '' : 'This browser gives the page no WebGL2 context: nothing can be drawn (the HUD still works).';
-const input = new Input(canvas);
+const overlay = document.getElementById('overlay')!;
+const input = new Input(canvas, overlay);
 const camera = new OrbitCamera();
 const net = new Connection(wsUrl, !observerAsked, `web ${navigator.userAgent.split(' ').pop() ?? ''}`.slice(0, 64),
                            () => input.movement(camera).map((c) => c * PLAYER_SPEED));
-const hud = new Hud(document.getElementById('overlay')!);
+const hud = new Hud(overlay);
 let framed = '';  // the tank the camera was framed for: again only when a scene's tank differs
 let kindsOf: unknown = null;
 let showTank = true;
@@ -123,5 +124,7 @@ requestAnimationFrame(frame);
     framesDrawn,
     bytes: net.bytes,
     fps,
+    cameraDistance: camera.distanceToTarget(),
+    touchPadShown: !document.querySelector<HTMLElement>('.touchpad')!.hidden,
   }),
 };
