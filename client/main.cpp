@@ -1,8 +1,12 @@
 // fishtank-client: a scripted test and load client (see --help).
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "client/options.h"
 #include "common/host_port.h"
@@ -78,7 +82,22 @@ int main(int argc, char** argv) {
               << std::lround(100.0 * s.load) << " % on " << s.threads_stepping << " of " << s.worker_threads
               << " threads, time scale " << s.time_scale << " (set " << s.time_scale_set << "); scene " << s.scene
               << (s.paused ? ", paused" : "") << "\n";
-    for (const std::string& e : s.error_messages) std::cout << "error: " << e << "\n";
+    // Each message once, with how many connections got it: 12 observers beyond --max-players say the same.
+    std::vector<std::pair<std::string, int>> errors;
+    for (const std::string& e : s.error_messages) {
+      const auto same = std::find_if(errors.begin(), errors.end(), [&](const auto& seen) { return seen.first == e; });
+      if (same == errors.end())
+        errors.emplace_back(e, 1);
+      else
+        ++same->second;
+    }
+    for (const auto& [e, count] : errors)
+      std::cout << "error: " << e << (count > 1 ? " (" + std::to_string(count) + " connections)" : "") << "\n";
+  }
+  if (s.welcomed < s.clients) {
+    std::cerr << "fishtank-client: " << s.clients - s.welcomed << " of " << s.clients
+              << " connections were not welcomed (the server's reasons are above)\n";
+    return 1;
   }
   if (s.dropped > 0) {
     std::cerr << "fishtank-client: the server dropped " << s.dropped << " of " << s.clients << " connections\n";

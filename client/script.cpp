@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "client/connection.h"
+#include "common/pending_connections.h"
 #include "common/server_hint.h"
 
 namespace fishtank::client {
@@ -19,6 +20,8 @@ namespace {
 
 constexpr auto kTick = std::chrono::milliseconds(50);
 constexpr int kTicksPerPing = 5;
+// While connections are still to open: how often to look whether one more may wait for its Welcome.
+constexpr auto kRampTick = std::chrono::milliseconds(1);
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
@@ -100,8 +103,23 @@ Summary run_script(const Script& script, const std::function<void(const Interval
     connections.push_back(
         std::make_shared<Connection>(io, "fishtank-client-" + std::to_string(i + 1), !script.observer));
     connections.back()->acknowledge_snapshots(script.acknowledge);
-    connections.back()->start(server);
   }
+  // Opened a few at a time: all at once, a server's --max-pending-per-address would evict most of them as a
+  // stranger's stalled connections before their Hello is read.
+  std::size_t opened = 0;
+  asio::steady_timer ramp(io);
+  std::function<void()> open_more = [&] {
+    std::size_t waiting = 0;
+    for (std::size_t i = 0; i < opened; ++i) waiting += !connections[i]->welcomed() && !connections[i]->closed();
+    for (; opened < connections.size() && waiting < kDefaultMaxPendingPerAddress; ++opened, ++waiting)
+      connections[opened]->start(server);
+    if (opened == connections.size()) return;
+    ramp.expires_after(kRampTick);
+    ramp.async_wait([&](boost::system::error_code e) {
+      if (!e) open_more();
+    });
+  };
+  open_more();
 
   const Clock::time_point start = Clock::now();
   bool added = false;  // the controls and --add were sent
@@ -127,7 +145,8 @@ Summary run_script(const Script& script, const std::function<void(const Interval
   std::function<void()> on_tick = [&] {
     const double t = seconds_since(start);
     if (t >= script.duration) {
-      for (auto& c : connections) c->close();
+      ramp.cancel();
+      for (std::size_t i = 0; i < opened; ++i) connections[i]->close();
       return;
     }
     if (script.every > 0.0 && on_interval && t >= reported.t + script.every) report_interval(t);
@@ -168,6 +187,9 @@ Summary run_script(const Script& script, const std::function<void(const Interval
     summary.error_messages.push_back("dropped by the server after " + std::to_string(std::lround(dropped_at[i])) +
                                      " s: " + connections[i]->close_reason());
   }
+  if (opened < connections.size())
+    summary.error_messages.push_back(std::to_string(connections.size() - opened) +
+                                     " connections not opened: --duration ended while earlier ones waited for Welcome");
   if (summary.welcomed == 0 && !connections.empty()) summary.connect_error = connections.front()->close_reason();
   return summary;
 }

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdint>
 
+#include "common/pending_connections.h"
 #include "server/control_policy.h"
 
 namespace fishtank::net {
@@ -20,7 +21,7 @@ struct ClientLimits {
   std::uint32_t max_connections = 64;
   // Connections from one address that have not said Hello; a newcomer beyond it
   // evicts the oldest of them, so a stranger's stalled connections never exceed it.
-  std::uint32_t max_pending_per_address = 8;
+  std::uint32_t max_pending_per_address = kDefaultMaxPendingPerAddress;
   double hello_timeout_s = 5.0;  // from connecting to a complete Hello; then hello_timeout
   // A write that cannot finish for this long: the peer does not read. It gets
   // idle_timeout when it sent nothing meanwhile either, too_slow when it did.

@@ -452,3 +452,19 @@ TEST_CASE("Acks that cannot be true get an Error and a keyframe, and the connect
   CHECK(other->stats().keyframes == others_keyframes);
   CHECK(server.running());
 }
+
+TEST_CASE("fishtank-client --clients 60 on a server's default limits gets all 60 welcomed, none evicted as pending",
+          "[net]") {
+  // Opened all at once, most of them waited for their Hello to be read beyond --max-pending-per-address (8) and
+  // were evicted as a stranger's stalled connections: 8 of 60 welcomed.
+  ServerProcess server({"--balls", "100"});
+  client::Script script;
+  script.port = server.port();
+  script.clients = 60;
+  script.observer = true;
+  script.duration = 1.5;
+  const client::Summary summary = client::run_script(script);
+  CHECK(summary.welcomed == 60);
+  CHECK(summary.error_messages.empty());
+  CHECK(summary.snapshots > 60 * 30);  // every connection received snapshots for most of the 1.5 s
+}

@@ -4,7 +4,8 @@ than the tank holds and says what fits, as on a scene that holds fewer, where
 its default count becomes what fits; a port in use names --port and
 --port 0, with no "Ctrl-C stops" banner first; a final-state path that cannot
 be written is refused before the run, not after it; fishtank-client pointed
-where nothing listens gives the command that starts a server there; a server
+where nothing listens gives the command that starts a server there, and one
+whose connections are not all welcomed says so and fails; a server
 bound to every address gives the others an address that reaches it, not
 0.0.0.0."""
 
@@ -104,6 +105,30 @@ def test_a_client_with_no_server_says_where_why_and_the_command_that_starts_one_
     assert len(lines) == 1, run.stderr
     assert f"no connection to 127.0.0.1:{port}: cannot connect: Connection refused" in lines[0]
     assert lines[0].endswith(f"To start a server here: build/server/fishtank-server --port {port}"), lines[0]
+
+
+def test_a_client_whose_connections_are_not_all_welcomed_says_how_many_and_fails_and_says_each_reason_once():
+    server = subprocess.Popen([SERVER, "--port", "0", "--no-web", "--threads", "1", "--balls", "10",
+                               "--max-connections", "3", "--max-players", "1", "--duration", "20"],
+                              stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True)
+    try:
+        line = server.stderr.readline()
+        while line and not line.startswith("listening on"):
+            line = server.stderr.readline()
+        port = int(line.strip().rsplit(":", 1)[1])
+        run = subprocess.run([CLIENT, "--connect", f"127.0.0.1:{port}", "--clients", "4", "--duration", "1"],
+                             capture_output=True, text=True, timeout=30)
+    finally:
+        server.send_signal(signal.SIGTERM)
+        server.wait(timeout=10)
+    assert run.returncode == 1, run.stdout + run.stderr
+    assert run.stdout.startswith("3 of 4 clients welcomed"), run.stdout
+    errors = [line for line in run.stdout.splitlines() if line.startswith("error: ")]
+    assert any(e.startswith("error: player_limit: ") and e.endswith(" (2 connections)") for e in errors), errors
+    assert any(e.startswith("error: server_full: ") and "--max-connections" in e for e in errors), errors
+    assert len(errors) == len(set(errors)), errors
+    assert run.stderr.strip() == ("fishtank-client: 1 of 4 connections were not welcomed "
+                                  "(the server's reasons are above)"), run.stderr
 
 
 def test_a_server_that_takes_other_machines_gives_them_an_address_that_reaches_it_not_0_0_0_0():
