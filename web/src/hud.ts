@@ -99,7 +99,7 @@ export class Hud {
     if (!live) lines.push(`<div class="warn" id="freshness">${escape(note)}</div>`);
     const notice = net.currentNotice();
     if (notice) lines.push(`<div class="warn notice">${escape(notice)}</div>`);
-    lines.push('<div class="dim">H: help</div>');
+    lines.push('<div class="dim">H (or ? on a touch screen): help</div>');
     this.stats.innerHTML = lines.join('');
   }
 }
