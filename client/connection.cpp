@@ -34,17 +34,17 @@ void Connection::send_ping() {
   send(protocol::encode_ping(static_cast<std::uint32_t>(us.count())));
 }
 
-void Connection::close() {
+void Connection::close(const std::string& reason) {
   if (closed_) return;
   closed_ = true;
-  if (close_reason_.empty()) close_reason_ = "closed by the client";
+  if (close_reason_.empty()) close_reason_ = reason;
   boost::system::error_code ignored;
   socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
   socket_.close(ignored);
 }
 
 void Connection::fail(const std::string& reason) {
-  if (close_reason_.empty()) close_reason_ = reason;
+  if (close_reason_.empty()) close_reason_ = reason;  // "" (a write aborted by close): close's own
   close();
 }
 

@@ -69,7 +69,8 @@ class Connection : public std::enable_shared_from_this<Connection> {
   void send_ping();
   // Off: no Ack is sent, so every snapshot comes in full (as before deltas).
   void acknowledge_snapshots(bool on) { acknowledge_ = on; }
-  void close();
+  // The reason is kept unless an earlier one was (the server's, or a failure's).
+  void close(const std::string& reason = "closed by the client");
 
   bool welcomed() const { return welcomed_; }
   bool closed() const { return closed_; }

@@ -8,6 +8,7 @@
 #include "common/flag_values.h"
 #include "common/host_port.h"
 #include "common/number_text.h"
+#include "common/pending_connections.h"
 #include "protocol/frame_codec.h"
 
 namespace fishtank::client {
@@ -30,7 +31,7 @@ std::optional<Vec3> parse_vec3(const std::string& text) {
 ClientParse parse_client_options(int argc, const char* const argv[]) {
   ClientOptions o;
   std::string connect = "127.0.0.1:7878", move;
-  std::int64_t clients = 1, add = 0, step = 0, seed = -1;
+  std::int64_t clients = 1, add = 0, step = 0, seed = -1, max_pending = kDefaultMaxPendingPerAddress;
   std::string scene;
   float time_scale = 0.0f;
   bool reset = false, pause = false, resume = false;
@@ -40,6 +41,8 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   flags.add_options()("help,h", "print this help and exit")("connect", po::value(&connect)->default_value(connect),
                                                             "server address, host:port")(
       "clients", po::value(&clients)->default_value(clients), "concurrent connections, 1 .. 1000")(
+      "max-pending", po::value(&max_pending)->default_value(max_pending),
+      "connections waiting for their Welcome at once, 1 .. 1000: at most the server's --max-pending-per-address")(
       "observer", po::bool_switch(&o.script.observer), "ask for no player sphere")(
       "no-ack", po::bool_switch(&no_ack),
       "never acknowledge snapshots, so that the server sends each in full instead of a delta")(
@@ -77,8 +80,8 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   if (vm.count("help")) {
     std::ostringstream help;
     help << "fishtank-client: connects to a fishtank-server, runs a short script and reports what it received.\n\n"
-         << "Usage: fishtank-client [--connect host:port] [--clients K] [--observer] [--no-ack] [--add N]\n"
-         << "                       [--move x,y,z --for T] [--duration T] [--every T] [--json]\n"
+         << "Usage: fishtank-client [--connect host:port] [--clients K [--max-pending N]] [--observer] [--no-ack]\n"
+         << "                       [--add N] [--move x,y,z --for T] [--duration T] [--every T] [--json]\n"
          << "                       [--scene NAME | --reset] [--seed S] [--time-scale X] [--pause | --resume] [--step "
             "N]\n\n"
          << "Example: fishtank-client --clients 8 --add 1000 --move 2,0,0 --for 1 --duration 5 --json\n"
@@ -93,6 +96,8 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   o.script.port = address->port;
   if (clients < 1 || clients > 1000)
     return fail("--clients must be between 1 and 1000, got " + std::to_string(clients));
+  if (max_pending < 1 || max_pending > 1000)
+    return fail("--max-pending must be between 1 and 1000, got " + std::to_string(max_pending));
   if (add < 0 || add > protocol::kMaxAddBallsPerRequest)
     return fail("--add must be between 0 and " + std::to_string(protocol::kMaxAddBallsPerRequest) + ", got " +
                 std::to_string(add));
@@ -124,6 +129,7 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   o.script.reset = reset;
   o.script.step = static_cast<std::uint32_t>(step);
   o.script.clients = static_cast<int>(clients);
+  o.script.max_pending = static_cast<std::size_t>(max_pending);
   o.script.acknowledge = !no_ack;
   o.script.add = static_cast<std::uint32_t>(add);
   result.options = o;

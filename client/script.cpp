@@ -8,7 +8,6 @@
 #include <memory>
 
 #include "client/connection.h"
-#include "common/pending_connections.h"
 #include "common/server_hint.h"
 
 namespace fishtank::client {
@@ -30,15 +29,21 @@ Summary summarise(const std::vector<std::shared_ptr<Connection>>& connections, d
   s.clients = static_cast<int>(connections.size());
   std::vector<double> rtts;
   std::uint32_t newest_tick = 0;
+  int rated = 0;  // connections the rates are a mean over
   for (const auto& c : connections) {
     const ConnectionStats& st = c->stats();
     s.welcomed += c->welcomed();
     s.snapshots += st.snapshots;
     s.keyframes += st.keyframes;
-    s.bytes_per_s += st.bytes_received / seconds;
-    if (st.snapshots >= 2)
-      s.snapshot_rate_hz +=
-          (st.snapshots - 1) / std::chrono::duration<double>(*st.last_snapshot - *st.first_snapshot).count();
+    // Rates over the span a connection received snapshots, where that covers a quarter of the run: a connection
+    // opened late, or whose snapshots came in one burst (a client busier than the server), gives none.
+    const double span =
+        st.snapshots >= 2 ? std::chrono::duration<double>(*st.last_snapshot - *st.first_snapshot).count() : 0.0;
+    if (span >= 0.25 * seconds) {
+      ++rated;
+      s.snapshot_rate_hz += (st.snapshots - 1) / span;
+      s.bytes_per_s += st.bytes_received / span;
+    }
     rtts.insert(rtts.end(), st.rtt_ms.begin(), st.rtt_ms.end());
     s.error_messages.insert(s.error_messages.end(), st.errors.begin(), st.errors.end());
     for (const std::string& code : st.error_codes)
@@ -63,9 +68,9 @@ Summary summarise(const std::vector<std::shared_ptr<Connection>>& connections, d
     }
     if (!c->welcomed() && !c->close_reason().empty()) s.error_messages.push_back("connection: " + c->close_reason());
   }
-  if (s.clients > 0) {
-    s.snapshot_rate_hz /= s.clients;
-    s.bytes_per_s /= s.clients;
+  if (rated > 0) {
+    s.snapshot_rate_hz /= rated;
+    s.bytes_per_s /= rated;
   }
   if (!rtts.empty()) {
     std::nth_element(rtts.begin(), rtts.begin() + rtts.size() / 2, rtts.end());
@@ -104,14 +109,16 @@ Summary run_script(const Script& script, const std::function<void(const Interval
         std::make_shared<Connection>(io, "fishtank-client-" + std::to_string(i + 1), !script.observer));
     connections.back()->acknowledge_snapshots(script.acknowledge);
   }
-  // Opened a few at a time: all at once, a server's --max-pending-per-address would evict most of them as a
-  // stranger's stalled connections before their Hello is read.
+  // Opened a few at a time (--max-pending): all at once, a server's --max-pending-per-address would evict most of
+  // them as a stranger's stalled connections before their Hello is read.
   std::size_t opened = 0;
+  bool ended = false;  // --duration is over: a ramp tick already due opens nothing more
   asio::steady_timer ramp(io);
   std::function<void()> open_more = [&] {
+    if (ended) return;
     std::size_t waiting = 0;
     for (std::size_t i = 0; i < opened; ++i) waiting += !connections[i]->welcomed() && !connections[i]->closed();
-    for (; opened < connections.size() && waiting < kDefaultMaxPendingPerAddress; ++opened, ++waiting)
+    for (; opened < connections.size() && waiting < script.max_pending; ++opened, ++waiting)
       connections[opened]->start(server);
     if (opened == connections.size()) return;
     ramp.expires_after(kRampTick);
@@ -145,8 +152,11 @@ Summary run_script(const Script& script, const std::function<void(const Interval
   std::function<void()> on_tick = [&] {
     const double t = seconds_since(start);
     if (t >= script.duration) {
+      ended = true;
       ramp.cancel();
-      for (std::size_t i = 0; i < opened; ++i) connections[i]->close();
+      for (std::size_t i = 0; i < opened; ++i)
+        connections[i]->close(connections[i]->welcomed() ? "closed by the client"
+                                                         : "--duration ended before its Welcome");
       return;
     }
     if (script.every > 0.0 && on_interval && t >= reported.t + script.every) report_interval(t);
@@ -188,8 +198,9 @@ Summary run_script(const Script& script, const std::function<void(const Interval
                                      " s: " + connections[i]->close_reason());
   }
   if (opened < connections.size())
-    summary.error_messages.push_back(std::to_string(connections.size() - opened) +
-                                     " connections not opened: --duration ended while earlier ones waited for Welcome");
+    summary.error_messages.push_back(
+        std::to_string(connections.size() - opened) + " connections not opened: --duration ended while earlier ones " +
+        "waited for their Welcome (--max-pending " + std::to_string(script.max_pending) + ")");
   if (summary.welcomed == 0 && !connections.empty()) summary.connect_error = connections.front()->close_reason();
   return summary;
 }

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "common/pending_connections.h"
 #include "common/vec3.h"
 
 namespace fishtank::client {
@@ -19,6 +20,8 @@ struct Script {
   std::string host = "127.0.0.1";
   std::uint16_t port = 7878;
   int clients = 1;
+  // Connections waiting for their Welcome at once: a server evicts those beyond its --max-pending-per-address.
+  std::size_t max_pending = kDefaultMaxPendingPerAddress;
   bool observer = false;
   bool acknowledge = true;  // false (--no-ack): every snapshot comes in full
   std::uint32_t add = 0;
@@ -45,12 +48,13 @@ struct IntervalReport {
 struct Summary {
   int clients = 0;
   int welcomed = 0;
-  std::uint64_t snapshots = 0;    // total over all clients
-  std::uint64_t keyframes = 0;    // of those, the ones sent in full (the rest were deltas)
-  double snapshot_rate_hz = 0.0;  // mean per client
-  double bytes_per_s = 0.0;       // mean per client
-  double rtt_ms = 0.0;            // median over every Pong; 0 without any
-  std::uint32_t balls = 0;        // newest ball count seen
+  std::uint64_t snapshots = 0;  // total over all clients
+  std::uint64_t keyframes = 0;  // of those, the ones sent in full (the rest were deltas)
+  // Means over the connections that received snapshots for a quarter of the run or more, each over that span.
+  double snapshot_rate_hz = 0.0;
+  double bytes_per_s = 0.0;
+  double rtt_ms = 0.0;      // median over every Pong; 0 without any
+  std::uint32_t balls = 0;  // newest ball count seen
   // The server's figures in that newest snapshot, and Welcome's worker threads.
   double steps_per_s = 0.0;
   double load = 0.0;

@@ -467,4 +467,7 @@ TEST_CASE("fishtank-client --clients 60 on a server's default limits gets all 60
   CHECK(summary.welcomed == 60);
   CHECK(summary.error_messages.empty());
   CHECK(summary.snapshots > 60 * 30);  // every connection received snapshots for most of the 1.5 s
+  // A mean of each connection's rate over the span it received snapshots: about the server's 60 a second.
+  CHECK(summary.snapshot_rate_hz > 30.0);
+  CHECK(summary.snapshot_rate_hz < 70.0);
 }

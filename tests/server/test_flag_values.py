@@ -38,6 +38,7 @@ def test_a_value_with_one_dash_is_still_a_value(tmp_path):
 
 @pytest.mark.parametrize("flags, said", [
     (["--clients", "0"], "--clients must be between 1 and 1000, got 0"),
+    (["--max-pending", "0"], "--max-pending must be between 1 and 1000, got 0"),
     (["--add", "-1"], "--add must be between 0 and 100000, got -1"),
     (["--duration", "0"], "--duration must be more than 0 and at most 86400 seconds, got 0"),
     (["--for", "nan"], "--for must be seconds >= 0, got nan"),
