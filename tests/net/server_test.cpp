@@ -471,3 +471,21 @@ TEST_CASE("fishtank-client --clients 60 on a server's default limits gets all 60
   CHECK(summary.snapshot_rate_hz > 30.0);
   CHECK(summary.snapshot_rate_hz < 70.0);
 }
+
+TEST_CASE("fishtank-client stops at --duration with connections still unopened, and says how many", "[net]") {
+  ServerProcess server({"--balls", "100"});
+  client::Script script;
+  script.port = server.port();
+  script.clients = 500;
+  script.max_pending = 1;  // one Welcome at a time: 500 cannot all open in 0.3 s
+  script.observer = true;
+  script.duration = 0.3;
+  const auto start = std::chrono::steady_clock::now();
+  const client::Summary summary = client::run_script(script);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  CHECK(seconds < 2.0);  // a ramp tick due at the end once opened the rest, which then ran on forever
+  CHECK(summary.welcomed < 500);
+  CHECK(std::any_of(summary.error_messages.begin(), summary.error_messages.end(), [](const std::string& e) {
+    return e.find("connections not opened: --duration ended") != std::string::npos;
+  }));
+}
