@@ -129,7 +129,8 @@ test('on a touch screen a pad appears at the first touch: a pinch zooms, the sti
   const s0 = await waitForState(phone, (st) => st.connection === 'connected' && own(st), 'the phone\'s player');
   assert.equal(s0.touchPadShown, false, 'no pad before a touch: a mouse user never sees it');
   await phone.touchscreen.tap(210, 200);
-  await waitForState(phone, (st) => st.touchPadShown, 'the pad shown after a touch');
+  assert.ok((await waitForState(phone, (st) => st.touchPadShown, 'the pad shown after a touch')).touchStickShown,
+            'a player\'s pad has the stick');
 
   const far = s0.cameraDistance;
   const a = await phone.touchscreen.touchStart(180, 300);
@@ -199,13 +200,17 @@ test('the HUD says "disconnected" when the server stops, and the page reconnects
   assert.doesNotMatch(await waitForHud(page, (t) => !/disconnected/.test(t)), /disconnected/);
 });
 
-test('where the server has no player sphere to give, the page observes, says why, and P is refused', async () => {
+test('where the server has no player sphere to give, the page observes, says why, offers no stick, and P is refused', async () => {
   const full = await startServer(['--threads', '1', '--balls', '100', '--max-players', '0']);
   try {
     const p = await browser.newPage();
+    await p.setViewport({ width: 800, height: 600, hasTouch: true });
     await p.goto(full.url);
     const s = await waitForState(p, (st) => st.connection === 'connected' && st.serverBalls > 0, 'a snapshot');
     assert.equal(s.hasPlayer, false);
+    await p.touchscreen.tap(400, 200);
+    const pad = await waitForState(p, (st) => st.touchPadShown, 'the pad shown after a touch');
+    assert.equal(pad.touchStickShown, false, 'an observer\'s pad has no stick: it has no sphere to move');
     await p.keyboard.press('KeyP');
     const hud = await waitForHud(p, (t) => /not_permitted/.test(t));
     assert.match(hud, /Playerobserving: player_limit/);

@@ -109,6 +109,11 @@ export class Input {
     }, { passive: false });
   }
 
+  // Whether the touch pad offers the stick and ▲ ▼ (a player) or only its buttons (an observer).
+  setPlayer(hasPlayer: boolean): void {
+    this.pad.setPlayer(hasPlayer);
+  }
+
   takeActions(): Actions {
     const a = this.pending;
     this.pending = noActions();

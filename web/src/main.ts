@@ -59,6 +59,7 @@ function frame(nowMs: number): void {
     kindsOf = info;
   }
 
+  input.setPlayer(info?.hasPlayer ?? !observerAsked);
   const a = input.takeActions();
   if (a.toggleHelp) hud.toggleHelp();
   if (a.toggleHud) hud.toggleStats();
@@ -126,5 +127,6 @@ requestAnimationFrame(frame);
     fps,
     cameraDistance: camera.distanceToTarget(),
     touchPadShown: !document.querySelector<HTMLElement>('.touchpad')!.hidden,
+    touchStickShown: !document.querySelector<HTMLElement>('.touchpad .stick')!.hidden,
   }),
 };
