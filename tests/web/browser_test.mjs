@@ -213,7 +213,7 @@ test('where the server has no player sphere to give, the page observes, says why
     assert.equal(pad.touchStickShown, false, 'an observer\'s pad has no stick: it has no sphere to move');
     await p.keyboard.press('KeyP');
     const hud = await waitForHud(p, (t) => /not_permitted/.test(t));
-    assert.match(hud, /Playerobserving: player_limit/);
+    assert.match(hud, /Playerobserving: player_limit: .*; reload the page to ask for one again/);
     assert.match(hud, /Controlnot yours/);
     assert.match(hud, /not_permitted/);
     await p.close();

@@ -89,7 +89,9 @@ export class Hud {
     row('Round trip', roundTripText(net.rttMs, this.clockStep));
     if (info) {
       row('Player', info.hasPlayer ? 'yours is the white sphere with the amber ring'
-        : v.observerAsked ? 'observing, as asked (?observer)' : `observing: ${net.observing || 'the server gave no player sphere'}`);
+        : v.observerAsked ? 'observing, as asked (?observer)'
+          // The server hands a freed sphere to nobody: asking again is a reload.
+          : `observing: ${net.observing || 'the server gave no player sphere'}; reload the page to ask for one again`);
       row('Control', controlText(info.mayControl, info.controlPolicy));
     }
 
