@@ -1,11 +1,12 @@
 // The page's HUD words (web/src/hud_text.ts, bundled for node by tests/web/CMakeLists.txt): a round trip is
-// shown no finer than the browser's clock can time it, and that clock's step is found by sampling it.
+// shown no finer than the browser's clock can time it, that clock's step is found by sampling it, and the
+// control line claims this page's part only while it is known.
 
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 import { need } from './harness.mjs';
 
-const { clockStepMs, roundTripText } = await import(need('FISHTANK_WEB_MODULE'));
+const { clockStepMs, controlText, roundTripText } = await import(need('FISHTANK_WEB_MODULE'));
 
 // A clock that reads `step`-coarsened time and advances `tick` ms per read, like a browser's performance.now().
 const coarseClock = (step, tick = 0.013) => {
@@ -37,4 +38,10 @@ test('a round trip has only the decimals its clock resolves', () => {
   assert.equal(roundTripText(0.05, 0.1), '< 0.1 ms');
   assert.equal(roundTripText(0.2345, 0.005), '0.23 ms');
   assert.equal(roundTripText(-1, 0.1), '-');
+});
+
+test('the control line says whether this page may, and once the server freed its sphere the policy alone', () => {
+  assert.equal(controlText(true, 'players may'), 'yours (P O R [ ] 1-4): players may');
+  assert.equal(controlText(false, 'observers may not'), 'not yours: observers may not');
+  assert.equal(controlText(null, 'clients with a player sphere may'), 'clients with a player sphere may');
 });

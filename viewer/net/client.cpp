@@ -178,9 +178,18 @@ void NetClient::on_frame() {
     case wire::Payload::Error: {
       const wire::Error& e = *m.payload_as_Error();
       std::string text = server_text(e.message()->str());  // present: decode_frame checks
+      // The sphere was freed: from now on this viewer observes, and its HUD says so.
+      if (e.code() == wire::ErrorCode::player_idle && info_ && info_->has_player) {
+        auto observing = std::make_shared<ServerInfo>(*info_);
+        observing->has_player = false;
+        observing->may_control
+            .reset();  // the Welcome's answer was a player's; the policy decides an observer's
+        info_ = observing;
+      }
       return update_status([&](ConnectionStatus& s) {
         s.notice = "server: " + text;
         s.notice_time = steady_seconds();
+        s.info = info_;
       });
     }
     case wire::Payload::Pong: {

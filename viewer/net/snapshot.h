@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,8 +25,8 @@ struct ServerInfo {
   float tolerance = 0.0f;          // the per-collision error dt was chosen for; 0: dt given
   std::vector<BallKind> kinds;     // indexed by a ball's kind number
   std::uint32_t client_id = 0;
-  std::string control_policy;  // who may pause, step, reset, switch scene, set the time scale
-  bool may_control = false;    // whether this viewer may
+  std::string control_policy;       // who may pause, step, reset, switch scene, set the time scale
+  std::optional<bool> may_control;  // whether this viewer may; unknown once the server freed its sphere
   std::uint32_t player_id = 0;
   bool has_player = false;
 };

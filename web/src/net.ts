@@ -29,7 +29,7 @@ export interface ServerInfo {
   playerId: number;
   snapshotRateHz: number;
   controlPolicy: string;
-  mayControl: boolean;
+  mayControl: boolean | null;  // null: unknown since the server freed this page's sphere
 }
 
 export type State = 'connecting' | 'connected' | 'disconnected';
@@ -139,7 +139,10 @@ export class Connection {
         // Why this page observes stays on the HUD, not only for a notice's few seconds.
         if (e.code() === ErrorCode.player_limit || e.code() === ErrorCode.player_idle) this.observing = text;
         // The sphere was freed: from now on this page observes.
-        if (e.code() === ErrorCode.player_idle && this.info) this.info.hasPlayer = false;
+        if (e.code() === ErrorCode.player_idle && this.info) {
+          this.info.hasPlayer = false;
+          this.info.mayControl = null;  // the Welcome's answer was a player's; the policy decides an observer's
+        }
         return this.say(text);
       }
       case Payload.Pong: {
