@@ -154,9 +154,12 @@ Summary run_script(const Script& script, const std::function<void(const Interval
     if (t >= script.duration) {
       ended = true;
       ramp.cancel();
-      for (std::size_t i = 0; i < opened; ++i)
-        connections[i]->close(connections[i]->welcomed() ? "closed by the client"
-                                                         : "--duration ended before its Welcome");
+      for (std::size_t i = 0; i < opened; ++i) {
+        if (connections[i]->welcomed())
+          connections[i]->close();
+        else
+          connections[i]->close("--duration ended before its Welcome");
+      }
       return;
     }
     if (script.every > 0.0 && on_interval && t >= reported.t + script.every) report_interval(t);
