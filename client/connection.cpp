@@ -111,6 +111,14 @@ void Connection::handle(const wire::Message& message) {
       const char* name = wire::EnumNameErrorCode(e.code());
       stats_.error_codes.push_back(*name ? name : std::to_string(static_cast<int>(e.code())));
       stats_.errors.push_back(stats_.error_codes.back() + ": " + server_text(e.message()->str()));
+      if (e.code() == wire::ErrorCode::player_idle) player_id_.reset();  // the sphere was freed
+      break;
+    }
+    case wire::Payload::PlayerGranted: {
+      const wire::PlayerGranted& g = *message.payload_as_PlayerGranted();
+      player_id_ = g.player_id();
+      may_control_ = g.may_control();
+      stats_.player_granted = true;
       break;
     }
     case wire::Payload::Pong: {

@@ -27,6 +27,7 @@ struct ConnectionStats {
   std::vector<double> rtt_ms;            // one per Pong
   std::vector<std::string> errors;       // Error messages, "code: message"
   std::vector<std::string> error_codes;  // the code of each Error, e.g. "too_slow"
+  bool player_granted = false;           // a sphere freed by another client came to this one (PlayerGranted)
   // Of the balls in both of the last two snapshots, the fraction whose quantised
   // position did not change: what an at-rest (delta) encoding could leave out.
   double at_rest_fraction = 0.0;
@@ -79,7 +80,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
   std::uint32_t worker_threads() const { return worker_threads_; }  // from Welcome: the most a step may use
   // The newest snapshot's tank (Welcome's until a snapshot says).
   const TankBounds& tank() const { return tank_; }
-  bool may_control() const { return may_control_; }  // from Welcome
+  bool may_control() const { return may_control_; }  // from Welcome, or PlayerGranted
   const std::string& control_policy() const { return control_policy_; }
   const ConnectionStats& stats() const { return stats_; }
   const WorldView& view() const { return view_; }

@@ -50,6 +50,8 @@ int main(int argc, char** argv) {
   if (o.json) {
     nlohmann::json j = {{"clients", s.clients},
                         {"welcomed", s.welcomed},
+                        {"players", s.players},
+                        {"players_granted", s.players_granted},
                         {"snapshots", s.snapshots},
                         {"keyframes", s.keyframes},
                         {"snapshot_rate_hz", s.snapshot_rate_hz},
@@ -76,12 +78,13 @@ int main(int argc, char** argv) {
                         {"error_messages", s.error_messages}};
     std::cout << j.dump() << std::endl;
   } else {
-    std::cout << s.welcomed << " of " << s.clients << " clients welcomed; " << s.snapshots << " snapshots ("
-              << s.snapshot_rate_hz << " Hz and " << s.bytes_per_s / 1e3 << " kB/s per client); rtt " << s.rtt_ms
-              << " ms; " << s.balls << " balls; server " << std::lround(s.steps_per_s) << " steps/s, load "
-              << std::lround(100.0 * s.load) << " % on " << s.threads_stepping << " of " << s.worker_threads
-              << " threads, time scale " << s.time_scale << " (set " << s.time_scale_set << "); scene " << s.scene
-              << (s.paused ? ", paused" : "") << "\n";
+    std::cout << s.welcomed << " of " << s.clients << " clients welcomed (" << s.players << " with a player sphere"
+              << (s.players_granted ? ", " + std::to_string(s.players_granted) + " given one another freed" : "")
+              << "); " << s.snapshots << " snapshots (" << s.snapshot_rate_hz << " Hz and " << s.bytes_per_s / 1e3
+              << " kB/s per client); rtt " << s.rtt_ms << " ms; " << s.balls << " balls; server "
+              << std::lround(s.steps_per_s) << " steps/s, load " << std::lround(100.0 * s.load) << " % on "
+              << s.threads_stepping << " of " << s.worker_threads << " threads, time scale " << s.time_scale << " (set "
+              << s.time_scale_set << "); scene " << s.scene << (s.paused ? ", paused" : "") << "\n";
     // Each message once, with how many connections got it: 12 observers beyond --max-players say the same.
     std::vector<std::pair<std::string, int>> errors;
     for (const std::string& e : s.error_messages) {

@@ -33,6 +33,8 @@ Summary summarise(const std::vector<std::shared_ptr<Connection>>& connections, d
   for (const auto& c : connections) {
     const ConnectionStats& st = c->stats();
     s.welcomed += c->welcomed();
+    s.players += c->player_id().has_value();
+    s.players_granted += st.player_granted;
     s.snapshots += st.snapshots;
     s.keyframes += st.keyframes;
     // Rates over the span a connection received snapshots, where that covers a quarter of the run: a connection

@@ -48,6 +48,8 @@ struct IntervalReport {
 struct Summary {
   int clients = 0;
   int welcomed = 0;
+  int players = 0;              // connections holding a player sphere at the end
+  int players_granted = 0;      // connections that waited in line and were given a sphere another freed
   std::uint64_t snapshots = 0;  // total over all clients
   std::uint64_t keyframes = 0;  // of those, the ones sent in full (the rest were deltas)
   // Means over the connections that received snapshots for a quarter of the run or more, each over that span.

@@ -53,6 +53,7 @@ bool accepted_by(wire::Payload type, Direction to) {
     case wire::Payload::Snapshot:
     case wire::Payload::Error:
     case wire::Payload::Pong:
+    case wire::Payload::PlayerGranted:
       return to == Direction::to_client;
     default:
       return false;
@@ -105,6 +106,7 @@ std::string check_values(const wire::Message& m) {
     }
     case wire::Payload::Ping:
     case wire::Payload::Pong:
+    case wire::Payload::PlayerGranted:
     case wire::Payload::Pause:
     case wire::Payload::Ack:  // any tick: only the session knows which it sent
       return {};
@@ -330,6 +332,11 @@ Frame encode_error(wire::ErrorCode code, std::string_view message) {
   flatbuffers::FlatBufferBuilder b(128 + message.size());
   const auto text = b.CreateString(message.data(), message.size());
   return finish(b, wire::CreateError(b, code, text));
+}
+
+Frame encode_player_granted(std::uint32_t player_id, bool may_control) {
+  flatbuffers::FlatBufferBuilder b(64);
+  return finish(b, wire::CreatePlayerGranted(b, player_id, may_control));
 }
 
 Frame encode_pong(std::uint32_t client_time_us) {

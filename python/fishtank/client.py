@@ -18,7 +18,8 @@ import numpy as np
 
 from fishtank._protocol import PROTOCOL_VERSION
 from fishtank.wire import (AddBalls, BallKinds, Error, ErrorCode, Hello, Message, Pause, Payload, Ping,
-                           PlayerInput, Pong, Reset, SetTimeScale, Snapshot as WireSnapshot, Step, Vec3f, Welcome)
+                           PlayerGranted, PlayerInput, Pong, Reset, SetTimeScale, Snapshot as WireSnapshot, Step,
+                           Vec3f, Welcome)
 
 _IDENTIFIER = b"FTNK"
 _MAX_FRAME_BYTES = 64 << 20  # the server's cap (kMaxServerFrameBytes)
@@ -169,6 +170,8 @@ class Client:
 
     def move(self, velocity):
         """Sets the player sphere's velocity (metres per second, x y z); it keeps it until the next move()."""
+        if self.player_id is None:
+            self._drain()  # a sphere freed by another may have come meanwhile (PlayerGranted)
         if self.player_id is None:
             raise FishtankError("no_player", "this client has no player sphere to move")
         # Checked here, not refused by the server later: move() does not wait, so a refusal would be raised
@@ -414,8 +417,15 @@ class Client:
             self.errors.append(error)
             if self.welcome is None:
                 raise error
-            if error.code != "player_limit":  # the Welcome says so too: this client observes
+            if error.code == "player_idle":  # the sphere was freed; the client observes
+                self.player_id = None
+            if error.code != "player_limit":  # the Welcome says so too: this client observes, in line for a sphere
                 self._unraised.append(error)
+        elif kind == Payload.Payload.PlayerGranted:
+            g = PlayerGranted.PlayerGranted()
+            g.Init(table.Bytes, table.Pos)
+            self.player_id = g.PlayerId()
+            self.may_control = g.MayControl()
         elif kind == Payload.Payload.Pong:
             p = Pong.Pong()
             p.Init(table.Bytes, table.Pos)

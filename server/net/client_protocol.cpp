@@ -266,6 +266,13 @@ Outcome ClientProtocol::on_reply(const Reply& reply) {
     state_ = State::active;
     return out;
   }
+  if (const auto* granted = std::get_if<PlayerGrantedReply>(&reply.result)) {
+    has_player_ = true;
+    last_move_ = Clock::now();
+    out.replies.push_back(protocol::encode_player_granted(granted->player_id, may_control(info_.control, true)));
+    out.log = "given player sphere " + std::to_string(granted->player_id) + ", freed by another client";
+    return out;
+  }
   if (const auto* control = std::get_if<ControlRefusedReply>(&reply.result)) {
     using Why = ControlRefusedReply::Why;
     const wire::ErrorCode code = control->why == Why::not_paused    ? wire::ErrorCode::not_paused

@@ -96,6 +96,7 @@ class ClientProtocol {
   // True from the Welcome on: the client gets snapshots.
   bool welcomed() const { return state_ == State::active; }
   bool hello_received() const { return state_ != State::awaiting_hello; }
+  bool has_player() const { return has_player_; }
   const std::string& client_name() const { return name_; }
   // When the sphere will be freed unless it moves; empty without a sphere or with --player-idle 0.
   std::optional<Clock::time_point> player_idle_deadline() const;

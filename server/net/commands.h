@@ -56,6 +56,10 @@ struct JoinedReply {
   std::optional<std::uint32_t> player_id;  // empty: no sphere (not asked for, or all taken)
   std::string refusal;                     // why a sphere that was asked for was not given
 };
+// A sphere another client freed, for this client that asked for one and waited in line.
+struct PlayerGrantedReply {
+  std::uint32_t player_id = 0;
+};
 struct BallsAddedReply {
   std::string refusal;  // empty when all were accepted; else how many were and why no more
 };
@@ -74,7 +78,7 @@ struct ControlRefusedReply {
 
 struct Reply {
   std::uint32_t client_id = 0;
-  std::variant<JoinedReply, BallsAddedReply, ControlRefusedReply> result;
+  std::variant<JoinedReply, PlayerGrantedReply, BallsAddedReply, ControlRefusedReply> result;
 };
 
 // Bounded, so a client flooding commands faster than the physics drains them

@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <string>
 
 #include "server/physics/world_measures.h"
@@ -50,25 +51,8 @@ void PhysicsLink::at_step_boundary(World& world, const LoopStatus& status) {
 void PhysicsLink::apply(World& world, const Command& command) {
   const std::uint32_t client = command.client_id;
   std::visit(Overloaded{
-                 [&](const JoinCommand& join) {
-                   JoinedReply joined;
-                   if (join.wants_player) {
-                     if (world.player_count() < options_.max_players) {
-                       joined.player_id = world.add_player();
-                       player_of_client_[client] = *joined.player_id;
-                     } else {
-                       joined.refusal = "all " + std::to_string(options_.max_players) +
-                                        " player spheres are taken (--max-players); you are observing";
-                     }
-                   }
-                   reply_({client, std::move(joined)});
-                 },
-                 [&](const LeaveCommand&) {
-                   if (auto it = player_of_client_.find(client); it != player_of_client_.end()) {
-                     world.remove_player(it->second);
-                     player_of_client_.erase(it);
-                   }
-                 },
+                 [&](const JoinCommand& join) { this->join(world, client, join.wants_player); },
+                 [&](const LeaveCommand&) { leave(world, client); },
                  [&](const SetVelocityCommand& set) {
                    // Clients without a sphere have nothing to move; the decoder already refused NaN.
                    if (auto it = player_of_client_.find(client); it != player_of_client_.end())
@@ -110,6 +94,37 @@ void PhysicsLink::apply(World& world, const Command& command) {
                  [&](const TimeScaleCommand& scale) { control_.time_scale = scale.scale; },
              },
              command.action);
+}
+
+void PhysicsLink::join(World& world, std::uint32_t client, bool wants_player) {
+  JoinedReply joined;
+  if (wants_player && world.player_count() < options_.max_players) {
+    joined.player_id = world.add_player();
+    player_of_client_[client] = *joined.player_id;
+  } else if (wants_player && options_.max_players == 0) {
+    joined.refusal = "this server has no player spheres (--max-players 0); you are observing";
+  } else if (wants_player) {
+    waiting_for_player_.push_back(client);
+    joined.refusal = "all " + std::to_string(options_.max_players) +
+                     " player spheres are taken (--max-players); you are observing, in line for the next one freed";
+  }
+  reply_({client, std::move(joined)});
+}
+
+void PhysicsLink::leave(World& world, std::uint32_t client) {
+  // Leave ends a session, or frees an unmoved sphere (player_idle) while the client stays.
+  waiting_for_player_.erase(std::remove(waiting_for_player_.begin(), waiting_for_player_.end(), client),
+                            waiting_for_player_.end());
+  const auto it = player_of_client_.find(client);
+  if (it == player_of_client_.end()) return;
+  world.remove_player(it->second);
+  player_of_client_.erase(it);
+  if (waiting_for_player_.empty()) return;
+  const std::uint32_t next = waiting_for_player_.front();
+  waiting_for_player_.pop_front();
+  const std::uint32_t player_id = world.add_player();
+  player_of_client_[next] = player_id;
+  reply_({next, PlayerGrantedReply{player_id}});
 }
 
 void PhysicsLink::refresh_figures(const World& world, Clock::time_point now) {

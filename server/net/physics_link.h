@@ -3,7 +3,8 @@
 // every step boundary, it
 //   1. applies the commands the sessions queued (join, leave, velocity, add balls,
 //      and the sandbox's pause, step, reset and time scale) and hands each
-//      answer back to the io thread;
+//      answer back to the io thread; clients refused a sphere wait in line, and
+//      a freed sphere goes to the first of them;
 //   2. captures a snapshot when one is due (--snapshot-rate) and someone watches
 //      (quantised once for every client; the io thread codes the frames).
 // Nothing here runs on the io thread, so the world needs no lock.
@@ -11,6 +12,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <unordered_map>
 #include <vector>
@@ -48,6 +50,8 @@ class PhysicsLink {
   using Clock = std::chrono::steady_clock;
 
   void apply(World& world, const Command& command);
+  void join(World& world, std::uint32_t client, bool wants_player);
+  void leave(World& world, std::uint32_t client);
   void publish_snapshot(const World& world, const LoopStatus& status);
   // Refreshes the plotted figures (energy, contacts) when they are older than kFiguresPeriod.
   void refresh_figures(const World& world, Clock::time_point now);
@@ -69,6 +73,7 @@ class PhysicsLink {
 
   std::vector<Command> drained_;
   std::unordered_map<std::uint32_t, std::uint32_t> player_of_client_;
+  std::deque<std::uint32_t> waiting_for_player_;  // clients refused a sphere, first come first
   SnapshotEncoder encoder_;
   std::uint32_t tick_ = 0;
   Clock::time_point next_snapshot_ = Clock::now();

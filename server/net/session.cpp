@@ -67,13 +67,12 @@ void Session::offer_snapshot(SharedSnapshot snapshot) {
 
 void Session::deliver(const Reply& reply) {
   if (closed_) return;
-  const bool was_welcomed = protocol_.welcomed();
+  const bool was_welcomed = protocol_.welcomed(), had_player = protocol_.has_player();
   Outcome outcome = protocol_.on_reply(reply);
   // Counted before carry_out, which may close the session (and so uncount it).
-  if (!was_welcomed && protocol_.welcomed()) {
-    owner_.session_welcomed(*this);
-    arm_watchdog();  // a player sphere's idle deadline starts now
-  }
+  if (!was_welcomed && protocol_.welcomed()) owner_.session_welcomed(*this);
+  // A player sphere's idle deadline starts with the Welcome, or with a sphere given later.
+  if ((!was_welcomed && protocol_.welcomed()) || (!had_player && protocol_.has_player())) arm_watchdog();
   carry_out(std::move(outcome));
 }
 

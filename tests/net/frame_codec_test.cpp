@@ -119,7 +119,7 @@ TEST_CASE("every message survives encode then decode with its values intact", "[
     const protocol::Frame scale = protocol::encode_set_time_scale(0.25f);
     CHECK(decode(scale, Direction::to_server).message->payload_as_SetTimeScale()->scale() == 0.25f);
   }
-  SECTION("BallKinds, AddBalls, Ping, Pong, Error") {
+  SECTION("BallKinds, AddBalls, Ping, Pong, Error, PlayerGranted") {
     const std::uint8_t kinds[] = {0, 1, 2, 1};
     // A decoded message points into its frame, so the frames outlive the checks.
     const protocol::Frame kinds_frame = protocol::encode_ball_kinds(10, kinds, 4);
@@ -133,6 +133,12 @@ TEST_CASE("every message survives encode then decode with its values intact", "[
     auto e = decode(error_frame, Direction::to_client);
     REQUIRE(e.ok());
     CHECK(e.message->payload_as_Error()->code() == wire::ErrorCode::tank_full);
+    const protocol::Frame granted_frame = protocol::encode_player_granted(7, true);
+    auto g = decode(granted_frame, Direction::to_client);
+    REQUIRE(g.ok());
+    CHECK(g.message->payload_as_PlayerGranted()->player_id() == 7);
+    CHECK(g.message->payload_as_PlayerGranted()->may_control());
+    CHECK(decode(granted_frame, Direction::to_server).status == DecodeStatus::wrong_direction);
   }
 }
 

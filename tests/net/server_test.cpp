@@ -256,16 +256,67 @@ TEST_CASE("a protocol version mismatch is refused with a clear Error and a disco
   CHECK_THAT(old_client->stats().errors.front(), Catch::Contains("protocol version"));
 }
 
-TEST_CASE("more clients than --max-players: the extra one observes and is told so", "[net]") {
+TEST_CASE("more clients than --max-players wait in line, told so, and get freed spheres first come first served",
+          "[net]") {
   ServerProcess server({"--balls", "0", "--max-players", "1"});
   Clients clients(server.port());
   auto first = clients.add(true);
   REQUIRE(clients.wait_until([&] { return first->welcomed(); }, std::chrono::seconds(5)));
   auto second = clients.add(true);
   REQUIRE(clients.wait_until([&] { return second->welcomed(); }, std::chrono::seconds(5)));
-  CHECK(first->player_id().has_value());
+  auto third = clients.add(true);
+  auto quitter = clients.add(true);
+  auto observer = clients.add(false);
+  REQUIRE(clients.wait_until([&] { return clients.all_welcomed(); }, std::chrono::seconds(5)));
+  REQUIRE(first->player_id().has_value());
   CHECK_FALSE(second->player_id().has_value());
-  CHECK(has_error(*second, "player_limit"));
+  REQUIRE(has_error(*second, "player_limit"));
+  CHECK_THAT(second->stats().errors.front(), Catch::Contains("in line for the next one freed"));
+  CHECK(observer->stats().errors.empty());  // it asked for none, so it is not in line
+
+  // One in line that leaves gives up its place: the sphere skips it.
+  quitter->close();
+  clients.run_for(std::chrono::milliseconds(200));
+  first->close();
+  REQUIRE(clients.wait_until([&] { return second->player_id().has_value(); }, std::chrono::seconds(5)));
+  CHECK(second->stats().player_granted);
+  CHECK_FALSE(third->player_id().has_value());
+  CHECK(second->may_control());  // the default policy: players may control
+
+  // The granted sphere is second's to move.
+  const std::uint32_t id = *second->player_id();
+  REQUIRE(clients.wait_until([&] { return observer->player_position(id).has_value(); }, std::chrono::seconds(5)));
+  const Vec3 start = *observer->player_position(id);
+  second->send(protocol::encode_player_input(1, {5.0f, 0.0f, 0.0f}));
+  clients.run_for(std::chrono::milliseconds(600));
+  second->send(protocol::encode_player_input(2, {0.0f, 0.0f, 0.0f}));
+  REQUIRE(
+      clients.wait_until([&] { return observer->player_position(id)->x > start.x + 1.0f; }, std::chrono::seconds(5)));
+
+  second->close();
+  REQUIRE(clients.wait_until([&] { return third->player_id().has_value(); }, std::chrono::seconds(5)));
+  CHECK_FALSE(observer->player_id().has_value());
+  CHECK(third->stats().errors.size() == 1);  // player_limit, and nothing since
+}
+
+TEST_CASE("a sphere freed as unmoved (player_idle) goes to the one in line, not back to its idler", "[net]") {
+  ServerProcess server({"--balls", "0", "--max-players", "1", "--player-idle", "0.5"});
+  Clients clients(server.port());
+  auto idler = clients.add(true);
+  REQUIRE(clients.wait_until([&] { return idler->welcomed(); }, std::chrono::seconds(5)));
+  auto waiting = clients.add(true);
+  REQUIRE(clients.wait_until([&] { return waiting->welcomed(); }, std::chrono::seconds(5)));
+  REQUIRE(idler->player_id().has_value());
+  REQUIRE_FALSE(waiting->player_id().has_value());
+
+  REQUIRE(clients.wait_until([&] { return waiting->player_id().has_value(); }, std::chrono::seconds(5)));
+  CHECK(has_error(*idler, "player_idle"));
+  CHECK_FALSE(idler->player_id().has_value());
+  CHECK_FALSE(idler->closed());
+  // The granted sphere has its own idle deadline: unmoved, it is freed in turn, and nobody waits for it.
+  REQUIRE(clients.wait_until([&] { return has_error(*waiting, "player_idle"); }, std::chrono::seconds(5)));
+  CHECK_FALSE(waiting->player_id().has_value());
+  CHECK_FALSE(idler->player_id().has_value());
 }
 
 TEST_CASE("bad bytes from one client: Error and disconnect for it - the server and other clients carry on", "[net]") {

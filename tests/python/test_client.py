@@ -120,6 +120,31 @@ def test_move_drives_the_player_sphere_and_add_balls_pours_more_in(start_server)
         assert full.value.code == "tank_full"
 
 
+def test_a_client_in_line_for_a_sphere_gets_the_one_its_holder_frees_and_can_move_it(start_server):
+    server = start_server("--balls", "0", "--max-players", "1")
+    holder = Client("127.0.0.1", server.port)
+    with Client("127.0.0.1", server.port) as waiting:
+        assert holder.player_id is not None and waiting.player_id is None
+        waiting.snapshot()  # the refusal follows the Welcome, before any snapshot
+        assert [e.code for e in waiting.errors] == ["player_limit"]
+        assert "in line for the next one freed" in waiting.errors[0].message
+        with pytest.raises(FishtankError) as none:
+            waiting.move((1.0, 0.0, 0.0))
+        assert none.value.code == "no_player"
+        holder.close()
+        deadline = time.monotonic() + 10
+        while waiting.player_id is None and time.monotonic() < deadline:
+            waiting.snapshot()
+        assert waiting.player_id is not None and waiting.may_control
+        start = waiting.snapshot()
+        mine = list(start.player_ids).index(waiting.player_id)
+        waiting.move((4.0, 0.0, 0.0))
+        time.sleep(1.0)
+        moved = waiting.snapshot()
+        assert moved.player_positions[list(moved.player_ids).index(waiting.player_id)][0] > \
+            start.player_positions[mine][0] + 2.0
+
+
 def test_refusals_raise_with_the_servers_reason_and_the_connection_keeps_working(start_server):
     server = start_server("--balls", "50")
     with Client("127.0.0.1", server.port) as tank, Client("127.0.0.1", server.port, player=False) as observer:

@@ -200,9 +200,12 @@ test('the HUD says "disconnected" when the server stops, and the page reconnects
   assert.doesNotMatch(await waitForHud(page, (t) => !/disconnected/.test(t)), /disconnected/);
 });
 
-test('where the server has no player sphere to give, the page observes, says why, offers no stick, and P is refused', async () => {
-  const full = await startServer(['--threads', '1', '--balls', '100', '--max-players', '0']);
+test('where every player sphere is taken, the page observes in line, says why, offers no stick, P is refused, and it gets the sphere its holder frees', async () => {
+  const full = await startServer(['--threads', '1', '--balls', '100', '--max-players', '1']);
   try {
+    const holder = await browser.newPage();
+    await holder.goto(full.url);
+    assert.equal((await waitForState(holder, (st) => st.connection === 'connected', 'a Welcome')).hasPlayer, true);
     const p = await browser.newPage();
     await p.setViewport({ width: 800, height: 600, hasTouch: true });
     await p.goto(full.url);
@@ -213,9 +216,17 @@ test('where the server has no player sphere to give, the page observes, says why
     assert.equal(pad.touchStickShown, false, 'an observer\'s pad has no stick: it has no sphere to move');
     await p.keyboard.press('KeyP');
     const hud = await waitForHud(p, (t) => /not_permitted/.test(t));
-    assert.match(hud, /Playerobserving: player_limit: .*; reload the page to ask for one again/);
+    assert.match(hud, /Playerobserving: player_limit: .*in line for the next one freed/);
+    assert.doesNotMatch(hud, /reload the page/, 'one in line needs no reload: the server hands it the next sphere');
     assert.match(hud, /Controlnot yours/);
     assert.match(hud, /not_permitted/);
+
+    await holder.close();  // its sphere is freed, and this page is first in line
+    const granted = await waitForState(p, (st) => st.hasPlayer && st.touchStickShown, 'the freed sphere, and the stick');
+    assert.ok(granted.players.some((pl) => pl.id === granted.playerId), 'the granted sphere is in the snapshots');
+    const playing = await waitForHud(p, (t) => /Playeryours/.test(t));
+    assert.match(playing, /Playeryours is the white sphere with the amber ring/);
+    assert.match(playing, /Controlyours/);
     await p.close();
   } finally {
     await full.stop();

@@ -192,6 +192,21 @@ void NetClient::on_frame() {
         s.info = info_;
       });
     }
+    case wire::Payload::PlayerGranted: {
+      if (!connected_) return lose("the server granted a player sphere before Welcome");
+      // Another client's sphere was freed and this viewer, in line for one, has it now.
+      const wire::PlayerGranted& g = *m.payload_as_PlayerGranted();
+      auto playing = std::make_shared<ServerInfo>(*info_);
+      playing->has_player = true;
+      playing->player_id = g.player_id();
+      playing->may_control = g.may_control();
+      info_ = playing;
+      return update_status([&](ConnectionStatus& s) {
+        s.notice = "server: a player sphere was freed and is yours now (the white one with the amber ring)";
+        s.notice_time = steady_seconds();
+        s.info = info_;
+      });
+    }
     case wire::Payload::Pong: {
       auto now_us = static_cast<std::uint32_t>((steady_seconds() - ping_epoch_) * 1e6);
       std::uint32_t rtt_us = now_us - m.payload_as_Pong()->client_time_us();  // modulo 2^32

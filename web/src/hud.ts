@@ -90,8 +90,8 @@ export class Hud {
     if (info) {
       row('Player', info.hasPlayer ? 'yours is the white sphere with the amber ring'
         : v.observerAsked ? 'observing, as asked (?observer)'
-          // The server hands a freed sphere to nobody: asking again is a reload.
-          : `observing: ${net.observing || 'the server gave no player sphere'}; reload the page to ask for one again`);
+          // One in line gets the next sphere freed; one whose sphere was freed asks again by a reload.
+          : `observing: ${net.observing || 'the server gave no player sphere'}${net.inLine ? '' : '; reload the page to ask for one again'}`);
       row('Control', controlText(info.mayControl, info.controlPolicy));
     }
 

@@ -4,7 +4,7 @@
 // deltas; the player's velocity 30 times a second; a Ping a second. When the
 // socket closes it tries again every second, for as long as the page is open.
 
-import { BallKinds, Error as WireError, ErrorCode, Message, Payload, Pong, Snapshot, Welcome } from 'fishtank-wire';
+import { BallKinds, Error as WireError, ErrorCode, Message, Payload, PlayerGranted, Pong, Snapshot, Welcome } from 'fishtank-wire';
 import { ReceivedSnapshots } from './delta';
 import type { BallKind } from './render';
 import { Frame, Player, SnapshotBuffer } from './snapshots';
@@ -52,6 +52,8 @@ export class Connection {
   decoded = 0;
   bytes = 0;  // received, in all
   observing = '';  // the server's reason when this page has no player sphere, if it gave one
+  inLine = false;  // refused a sphere for want of one: the server gives this page the next one freed
+  spheresGranted = 0;  // spheres freed by others that came to this page (PlayerGranted)
   private notice = '';
   private noticeTime = 0;
   private socket: WebSocket | null = null;
@@ -138,12 +140,25 @@ export class Connection {
         const text = `${ErrorCode[e.code()] ?? `error ${e.code()}`}: ${e.message() ?? ''}`;
         // Why this page observes stays on the HUD, not only for a notice's few seconds.
         if (e.code() === ErrorCode.player_limit || e.code() === ErrorCode.player_idle) this.observing = text;
+        this.inLine = e.code() === ErrorCode.player_limit || (this.inLine && e.code() !== ErrorCode.player_idle);
         // The sphere was freed: from now on this page observes.
         if (e.code() === ErrorCode.player_idle && this.info) {
           this.info.hasPlayer = false;
           this.info.mayControl = null;  // the Welcome's answer was a player's; the policy decides an observer's
         }
         return this.say(text);
+      }
+      case Payload.PlayerGranted: {
+        // Another client's sphere was freed and this page, in line for one, has it now.
+        const g = m.payload(new PlayerGranted()) as PlayerGranted;
+        if (!this.info) return this.lose('the server granted a player sphere before Welcome');
+        this.info.hasPlayer = true;
+        this.info.playerId = g.playerId();
+        this.info.mayControl = g.mayControl();
+        this.observing = '';
+        this.inLine = false;
+        ++this.spheresGranted;
+        return this.say('a player sphere was freed and is yours now (the white one with the amber ring)');
       }
       case Payload.Pong: {
         const p = m.payload(new Pong()) as Pong;
@@ -181,6 +196,7 @@ export class Connection {
       mayControl: w.mayControl(),
     };
     this.observing = '';
+    this.inLine = false;
     this.kinds = new Uint8Array(0);
     this.received.clear();
     this.snapshots.clear();
