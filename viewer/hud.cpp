@@ -129,15 +129,17 @@ void Hud::stats(const HudView& v) {
     row(live, "Round trip", "%.2f ms", net.rtt_ms);
   else
     row(live, "Round trip", "-");
-  if (v.observer || (net.info && !net.info->has_player))
+  ImGui::PushTextWrapPos(520.0f);
+  if (!v.observer && net.info && !net.info->has_player && !net.info->observing.empty())
+    row(live, "Player", "observing: %s", net.info->observing.c_str());
+  else if (v.observer || (net.info && !net.info->has_player))
     row(live, "Player", "observing");
   else
     row(live, "Player", "yours is the white sphere with the amber ring");
   if (const ServerInfo* info = net.info.get()) {
-    ImGui::PushTextWrapPos(520.0f);
     row(live, "Control", "%s", control_text(info->may_control, info->control_policy).c_str());
-    ImGui::PopTextWrapPos();
   }
+  ImGui::PopTextWrapPos();
   if (!live) ImGui::TextColored(kWarn, "%s", fresh.note.c_str());
   ImGui::TextColored(kDim, "H: help");
   if (!v.viewer_notice.empty() && v.now - v.viewer_notice_time < kNoticeSeconds) {

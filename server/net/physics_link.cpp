@@ -105,8 +105,10 @@ void PhysicsLink::join(World& world, std::uint32_t client, bool wants_player) {
     joined.refusal = "this server has no player spheres (--max-players 0); you are observing";
   } else if (wants_player) {
     waiting_for_player_.push_back(client);
-    joined.refusal = "all " + std::to_string(options_.max_players) +
-                     " player spheres are taken (--max-players); you are observing, in line for the next one freed";
+    joined.refusal =
+        (options_.max_players == 1 ? std::string("the one player sphere is taken")
+                                   : "all " + std::to_string(options_.max_players) + " player spheres are taken") +
+        " (--max-players); you are observing, in line for the next one freed";
   }
   reply_({client, std::move(joined)});
 }

@@ -178,12 +178,16 @@ void NetClient::on_frame() {
     case wire::Payload::Error: {
       const wire::Error& e = *m.payload_as_Error();
       std::string text = server_text(e.message()->str());  // present: decode_frame checks
-      // The sphere was freed: from now on this viewer observes, and its HUD says so.
-      if (e.code() == wire::ErrorCode::player_idle && info_ && info_->has_player) {
+      // Why this viewer observes stays on the HUD's Player row, not only for a notice's few seconds.
+      if ((e.code() == wire::ErrorCode::player_limit || e.code() == wire::ErrorCode::player_idle) && info_) {
         auto observing = std::make_shared<ServerInfo>(*info_);
-        observing->has_player = false;
-        observing->may_control
-            .reset();  // the Welcome's answer was a player's; the policy decides an observer's
+        observing->observing = text;
+        // The sphere was freed: from now on this viewer observes. The Welcome's answer was a
+        // player's; the policy decides an observer's.
+        if (e.code() == wire::ErrorCode::player_idle) {
+          observing->has_player = false;
+          observing->may_control.reset();
+        }
         info_ = observing;
       }
       return update_status([&](ConnectionStatus& s) {
@@ -198,6 +202,7 @@ void NetClient::on_frame() {
       const wire::PlayerGranted& g = *m.payload_as_PlayerGranted();
       auto playing = std::make_shared<ServerInfo>(*info_);
       playing->has_player = true;
+      playing->observing.clear();
       playing->player_id = g.player_id();
       playing->may_control = g.may_control();
       info_ = playing;

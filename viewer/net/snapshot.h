@@ -29,6 +29,8 @@ struct ServerInfo {
   std::optional<bool> may_control;  // whether this viewer may; unknown once the server freed its sphere
   std::uint32_t player_id = 0;
   bool has_player = false;
+  // Without a sphere, the server's reason (player_limit: in line for one; player_idle: it was freed).
+  std::string observing;
 };
 
 struct PlayerState {
