@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   const double bytes_per_ball = per_ball(s.bytes_per_s, s.snapshot_rate_hz, s.balls);
+  const std::vector<std::string> errors = fishtank::client::each_once(s.error_messages);
   if (o.json) {
     nlohmann::json j = {{"clients", s.clients},
                         {"welcomed", s.welcomed},
@@ -75,7 +76,7 @@ int main(int argc, char** argv) {
                         {"dropped", s.dropped},
                         {"errors", s.error_messages.size()},
                         {"error_codes", s.error_codes},
-                        {"error_messages", s.error_messages}};
+                        {"error_messages", errors}};
     std::cout << j.dump() << std::endl;
   } else {
     std::cout << s.welcomed << " of " << s.clients << " clients welcomed (" << s.players << " with a player sphere"
@@ -85,17 +86,7 @@ int main(int argc, char** argv) {
               << std::lround(s.steps_per_s) << " steps/s, load " << std::lround(100.0 * s.load) << " % on "
               << s.threads_stepping << " of " << s.worker_threads << " threads, time scale " << s.time_scale << " (set "
               << s.time_scale_set << "); scene " << s.scene << (s.paused ? ", paused" : "") << "\n";
-    // Each message once, with how many connections got it: 12 observers beyond --max-players say the same.
-    std::vector<std::pair<std::string, int>> errors;
-    for (const std::string& e : s.error_messages) {
-      const auto same = std::find_if(errors.begin(), errors.end(), [&](const auto& seen) { return seen.first == e; });
-      if (same == errors.end())
-        errors.emplace_back(e, 1);
-      else
-        ++same->second;
-    }
-    for (const auto& [e, count] : errors)
-      std::cout << "error: " << e << (count > 1 ? " (" + std::to_string(count) + " connections)" : "") << "\n";
+    for (const std::string& e : errors) std::cout << "error: " << e << "\n";
   }
   if (s.welcomed < s.clients) {
     std::cerr << "fishtank-client: " << s.clients - s.welcomed << " of " << s.clients

@@ -93,6 +93,21 @@ std::vector<protocol::Frame> control_frames(const Script& script) {
 
 }  // namespace
 
+std::vector<std::string> each_once(const std::vector<std::string>& messages) {
+  std::vector<std::pair<std::string, int>> counted;
+  for (const std::string& m : messages) {
+    const auto same = std::find_if(counted.begin(), counted.end(), [&](const auto& seen) { return seen.first == m; });
+    if (same == counted.end())
+      counted.emplace_back(m, 1);
+    else
+      ++same->second;
+  }
+  std::vector<std::string> out;
+  for (const auto& [m, count] : counted)
+    out.push_back(count > 1 ? m + " (" + std::to_string(count) + " connections)" : m);
+  return out;
+}
+
 Summary run_script(const Script& script, const std::function<void(const IntervalReport&)>& on_interval) {
   asio::io_context io;
   boost::system::error_code ec;

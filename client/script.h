@@ -79,6 +79,10 @@ struct Summary {
   int dropped = 0;
 };
 
+// Each message once, in the order first seen, with how many connections got it
+// ("... (12 connections)"): 12 observers beyond --max-players say the same.
+std::vector<std::string> each_once(const std::vector<std::string>& messages);
+
 // on_interval is called every script.every seconds (when that is > 0).
 Summary run_script(const Script& script, const std::function<void(const IntervalReport&)>& on_interval = {});
 

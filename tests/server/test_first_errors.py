@@ -116,8 +116,9 @@ def test_a_client_whose_connections_are_not_all_welcomed_says_how_many_and_fails
         while line and not line.startswith("listening on"):
             line = server.stderr.readline()
         port = int(line.strip().rsplit(":", 1)[1])
-        run = subprocess.run([CLIENT, "--connect", f"127.0.0.1:{port}", "--clients", "4", "--duration", "1"],
-                             capture_output=True, text=True, timeout=30)
+        client = [CLIENT, "--connect", f"127.0.0.1:{port}", "--clients", "4", "--duration", "1"]
+        run = subprocess.run(client, capture_output=True, text=True, timeout=30)
+        as_json = subprocess.run(client + ["--json"], capture_output=True, text=True, timeout=30)
     finally:
         server.send_signal(signal.SIGTERM)
         server.wait(timeout=10)
@@ -129,6 +130,12 @@ def test_a_client_whose_connections_are_not_all_welcomed_says_how_many_and_fails
     assert len(errors) == len(set(errors)), errors
     assert run.stderr.strip() == ("fishtank-client: 1 of 4 connections were not welcomed "
                                   "(the server's reasons are above)"), run.stderr
+    # --json lists each message once too, with the same count, and counts every error.
+    summary = json.loads(as_json.stdout)
+    counts = [int(m.group(1)) if (m := re.search(r" \((\d+) connections\)$", e)) else 1
+              for e in summary["error_messages"]]
+    assert sum(counts) == summary["errors"] and len(set(summary["error_messages"])) == len(counts), summary
+    assert any(e.startswith("player_limit: ") and e.endswith(" (2 connections)") for e in summary["error_messages"])
 
 
 def test_a_server_that_takes_other_machines_gives_them_an_address_that_reaches_it_not_0_0_0_0():
