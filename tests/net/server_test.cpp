@@ -299,6 +299,59 @@ TEST_CASE("more clients than --max-players wait in line, told so, and get freed 
   CHECK(third->stats().errors.size() == 1);  // player_limit, and nothing since
 }
 
+TEST_CASE("through joins and leaves in any order, every sphere has one holder and none waits while one is free",
+          "[net]") {
+  constexpr int kMaxPlayers = 4;
+  // Room for every connection opened in a burst to wait for its Welcome, none evicted as a stranger's.
+  ServerProcess server(
+      {"--balls", "0", "--max-players", std::to_string(kMaxPlayers), "--max-pending-per-address", "64"});
+  Clients clients(server.port());
+  auto watcher = clients.add(false);
+  std::vector<std::shared_ptr<Connection>> live;
+  std::uint32_t seed = 12345;
+  const auto next_random = [&] { return seed = seed * 1664525u + 1013904223u; };
+  for (int round = 0; round < 60; ++round) {
+    // Mostly joins while few are connected, mostly leaves while many are: the line grows and empties.
+    if (live.empty() || next_random() % 12 >= live.size())
+      live.push_back(clients.add(true));
+    else {
+      const auto leaving = live.begin() + next_random() % live.size();
+      (*leaving)->close();
+      live.erase(leaving);
+    }
+    clients.run_for(std::chrono::milliseconds(next_random() % 30));
+  }
+  const auto holders = [&] {
+    std::vector<std::uint32_t> ids;
+    for (auto& c : live)
+      if (c->player_id()) ids.push_back(*c->player_id());
+    std::sort(ids.begin(), ids.end());
+    return ids;
+  };
+  const auto spheres = [&] {
+    std::vector<std::uint32_t> ids = watcher->view().player_ids;
+    std::sort(ids.begin(), ids.end());
+    return ids;
+  };
+  const std::size_t expected = std::min<std::size_t>(live.size(), kMaxPlayers);
+  INFO(live.size() << " clients want a sphere at the end");
+  REQUIRE(clients.wait_until([&] { return holders().size() == expected && spheres() == holders(); },
+                             std::chrono::seconds(10)));
+  const std::vector<std::uint32_t> held = holders();
+  CHECK(std::adjacent_find(held.begin(), held.end()) == held.end());  // no sphere with two holders
+  // Closing every holder hands each sphere on down the line until the line is empty.
+  while (!live.empty()) {
+    auto holder = std::find_if(live.begin(), live.end(), [](auto& c) { return c->player_id().has_value(); });
+    REQUIRE(holder != live.end());
+    (*holder)->close();
+    live.erase(holder);
+    const std::size_t now_expected = std::min<std::size_t>(live.size(), kMaxPlayers);
+    REQUIRE(clients.wait_until([&] { return holders().size() == now_expected && spheres() == holders(); },
+                               std::chrono::seconds(10)));
+  }
+  CHECK(spheres().empty());
+}
+
 TEST_CASE("a sphere freed as unmoved (player_idle) goes to the one in line, not back to its idler", "[net]") {
   ServerProcess server({"--balls", "0", "--max-players", "1", "--player-idle", "0.5"});
   Clients clients(server.port());
