@@ -28,7 +28,7 @@ std::string scene_help() {
 ParseResult parse_server_options(int argc, const char* const argv[], const char* variant, bool threaded) {
   ServerOptions o;
   PhysicsParams defaults;
-  std::int64_t balls = -1, steps = static_cast<std::int64_t>(o.bench_spec.steps);
+  std::int64_t balls = 0, steps = static_cast<std::int64_t>(o.bench_spec.steps);
   std::int64_t threads = threaded ? WorkerPool::hardware_threads() : 1, max_balls = 0, seed = 1;
   std::int64_t steps_per_contact = defaults.steps_per_contact;
   double settle_time = 0.0;
@@ -166,8 +166,8 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   };
   if (!is_scene_name(o.bench_spec.scene.name))
     return fail("unknown scene '" + o.bench_spec.scene.name + "'; the scenes are " + scene_names_text());
-  o.balls_given = balls != -1;
-  if (balls == -1) balls = o.bench ? 6000 : default_balls(o.bench_spec.scene.name);
+  o.balls_given = vm.count("balls") > 0;
+  if (!o.balls_given) balls = o.bench ? 6000 : default_balls(o.bench_spec.scene.name);
   if (balls < 0 || balls > 10'000'000)
     return fail("--balls must be between 0 and 10000000, got " + std::to_string(balls));
   // A rate and a capacity measured on no balls would read as "this build holds none".

@@ -151,6 +151,7 @@ TEST_CASE("every bad value is refused with a message naming it and exit code 2",
   };
   const std::vector<Bad> bad = {
       {{"--balls", "-5"}, "--balls must be between"},
+      {{"--balls", "-1"}, "--balls must be between"},  // -1 once meant "not given"
       {{"--balls", "20000000"}, "--balls must be between"},
       {{"--balls", "many"}, "balls"},
       {{"--threads", "0"}, "--threads must be between"},
