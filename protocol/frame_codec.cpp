@@ -47,6 +47,7 @@ bool accepted_by(wire::Payload type, Direction to) {
     case wire::Payload::Reset:
     case wire::Payload::SetTimeScale:
     case wire::Payload::Ack:
+    case wire::Payload::Watching:
       return to == Direction::to_server;
     case wire::Payload::Welcome:
     case wire::Payload::BallKinds:
@@ -108,6 +109,7 @@ std::string check_values(const wire::Message& m) {
     case wire::Payload::Pong:
     case wire::Payload::PlayerGranted:
     case wire::Payload::Pause:
+    case wire::Payload::Watching:
     case wire::Payload::Ack:  // any tick: only the session knows which it sent
       return {};
     case wire::Payload::Step: {
@@ -229,6 +231,11 @@ Frame encode_set_time_scale(float scale) {
 Frame encode_ack(std::uint32_t tick, bool want_keyframe) {
   flatbuffers::FlatBufferBuilder b(64);
   return finish(b, wire::CreateAck(b, tick, want_keyframe));
+}
+
+Frame encode_watching(bool on) {
+  flatbuffers::FlatBufferBuilder b(64);
+  return finish(b, wire::CreateWatching(b, on));
 }
 
 Frame encode_welcome(const WelcomeInfo& info) {

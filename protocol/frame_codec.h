@@ -66,6 +66,8 @@ Frame encode_step(std::uint32_t count);
 Frame encode_reset(std::string_view scene, std::optional<std::uint64_t> seed);
 Frame encode_set_time_scale(float scale);
 Frame encode_ack(std::uint32_t tick, bool want_keyframe = false);
+// Off: no Snapshots for this client until on again (a page in a hidden tab).
+Frame encode_watching(bool on);
 
 // ---- encoding: server -> client ----
 struct WelcomeInfo {

@@ -132,6 +132,9 @@ Outcome ClientProtocol::on_message(const wire::Message& message, Clock::time_poi
     case wire::Payload::Reset:
     case wire::Payload::SetTimeScale:
       return on_control(message);
+    case wire::Payload::Watching:
+      watching_ = message.payload_as_Watching()->on();
+      return out;
     case wire::Payload::Ack: {
       const wire::Ack& ack = *message.payload_as_Ack();
       if (std::string why = acks_.acknowledged(ack.tick(), ack.want_keyframe()); !why.empty())

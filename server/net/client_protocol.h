@@ -93,8 +93,10 @@ class ClientProtocol {
   // The snapshot sent before that one, to predict moving balls from; empty: none.
   std::optional<std::uint32_t> delta_prior() const { return acks_.prior(); }
 
-  // True from the Welcome on: the client gets snapshots.
+  // True from the Welcome on: the client gets snapshots (while it is watching).
   bool welcomed() const { return state_ == State::active; }
+  // False while the client said it wants no snapshots (Watching off: a hidden page).
+  bool watching() const { return watching_; }
   bool hello_received() const { return state_ != State::awaiting_hello; }
   bool has_player() const { return has_player_; }
   const std::string& client_name() const { return name_; }
@@ -116,6 +118,7 @@ class ClientProtocol {
   State state_ = State::awaiting_hello;
   std::string name_;
   bool has_player_ = false;
+  bool watching_ = true;
   Clock::time_point last_move_;  // the last PlayerInput with a non-zero velocity, or the Welcome
   RateBudget commands_;
   RateBudget ack_budget_;  // twice the snapshot rate: an Ack per snapshot, and room for a late burst

@@ -372,6 +372,30 @@ TEST_CASE("a sphere freed as unmoved (player_idle) goes to the one in line, not 
   CHECK_FALSE(idler->player_id().has_value());
 }
 
+TEST_CASE("a client that says Watching off gets no snapshots but its replies, and on again gets deltas it decodes",
+          "[net]") {
+  ServerProcess server({"--balls", "300"});
+  Clients clients(server.port());
+  auto hidden = clients.add(true);
+  REQUIRE(clients.wait_until([&] { return hidden->stats().snapshots > 10; }, std::chrono::seconds(5)));
+  hidden->send(protocol::encode_watching(false));
+  clients.run_for(std::chrono::milliseconds(200));  // one snapshot may already be on its way
+  const std::uint64_t before = hidden->stats().snapshots;
+  const std::size_t pongs = hidden->stats().rtt_ms.size();
+  hidden->send_ping();
+  clients.run_for(std::chrono::milliseconds(1000));
+  CHECK(hidden->stats().snapshots == before);
+  CHECK(hidden->stats().rtt_ms.size() == pongs + 1);  // replies still come
+  CHECK_FALSE(hidden->closed());
+
+  hidden->send(protocol::encode_watching(true));
+  const std::uint64_t keyframes = hidden->stats().keyframes;
+  REQUIRE(clients.wait_until([&] { return hidden->stats().snapshots > before + 30; }, std::chrono::seconds(5)));
+  CHECK(hidden->stats().keyframes == keyframes + 1);  // its base expired while it watched nothing
+  CHECK(hidden->stats().errors.empty());
+  CHECK(hidden->view().ball_count > 0);
+}
+
 TEST_CASE("bad bytes from one client: Error and disconnect for it - the server and other clients carry on", "[net]") {
   ServerProcess server({"--balls", "300"});
   Clients clients(server.port());

@@ -187,6 +187,30 @@ test('two tabs see one world: each sees the other\'s player, and one tab\'s move
   await second.close();
 });
 
+test('a page hidden over two seconds asks for no snapshots, and shown again decodes the world without asking for a keyframe', async () => {
+  const setVisibility = (p, state) => p.evaluate((s) => {
+    Object.defineProperty(document, 'visibilityState', { get: () => s, configurable: true });
+    document.dispatchEvent(new Event('visibilitychange'));
+  }, state);
+  await page.bringToFront();
+  const shown = await waitForState(page, (st) => st.connection === 'connected' && st.watching, 'a watching page');
+  await setVisibility(page, 'hidden');
+  await sleep(1000);
+  assert.equal((await waitForState(page, () => true, 'state')).watching, true, 'a glance away keeps the snapshots');
+  const off = await waitForState(page, (st) => !st.watching, 'watching off after the grace');
+  await sleep(500);  // a snapshot already sent may still arrive
+  const quiet = await waitForState(page, () => true, 'state');
+  await sleep(1500);
+  const later = await waitForState(page, () => true, 'state');
+  assert.equal(later.decoded, quiet.decoded, 'no snapshot decoded while hidden');
+  assert.equal(later.bytes - quiet.bytes < 2000, true, `at most a few Pongs received while hidden, got ${later.bytes - quiet.bytes} bytes`);
+  await setVisibility(page, 'visible');
+  const back = await waitForState(page, (st) => st.watching && st.decoded > later.decoded + 30, 'snapshots again');
+  assert.equal(back.keyframeRequests, shown.keyframeRequests, 'the server sent what the page could decode');
+  assert.equal(back.connection, 'connected');
+  assert.ok(off.serverBalls > 0 && back.serverBalls >= off.serverBalls);
+});
+
 test('the HUD says "disconnected" when the server stops, and the page reconnects when it returns', async () => {
   const port = server.port;
   await server.stop();

@@ -103,6 +103,8 @@ function frame(nowMs: number): void {
   requestAnimationFrame(frame);
 }
 requestAnimationFrame(frame);
+document.addEventListener('visibilitychange', () => net.setVisible(document.visibilityState !== 'hidden'));
+net.setVisible(document.visibilityState !== 'hidden');
 
 // What the browser tests (tests/web) read; plain values, so page.evaluate can return them.
 (window as unknown as { fishtank: unknown }).fishtank = {
@@ -110,6 +112,7 @@ requestAnimationFrame(frame);
     webgl2: gl !== null,
     connection: net.state,
     welcomes: net.welcomes,
+    watching: net.watching,
     hasPlayer: net.info?.hasPlayer ?? false,
     playerId: net.info?.playerId ?? -1,
     clientId: net.info?.clientId ?? -1,

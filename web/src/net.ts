@@ -13,6 +13,9 @@ import * as wire from './wire';
 const INPUT_PERIOD_MS = 1000 / 30;
 const RECONNECT_MS = 1000;
 const NOTICE_SECONDS = 8;
+// A page hidden this long asks for no snapshots: it draws none, and decoding
+// them would cost the student's processor. A glance at another tab keeps them.
+const HIDDEN_GRACE_MS = 2000;
 
 export interface ServerInfo {
   clientId: number;
@@ -60,6 +63,8 @@ export class Connection {
   private kinds = new Uint8Array(0);
   private readonly received = new ReceivedSnapshots();
   private inputSequence = 0;
+  watching = true;  // whether the server is asked for snapshots (Watching)
+  private hiddenTimer: ReturnType<typeof setTimeout> | undefined;
   private snapshotsThisSecond = 0;
   private bytesThisSecond = 0;
   private secondStarted = seconds();
@@ -76,6 +81,19 @@ export class Connection {
   // The newest server notice (an Error's words, a lost connection), while it is recent.
   currentNotice(): string {
     return this.notice && seconds() - this.noticeTime < NOTICE_SECONDS ? this.notice : '';
+  }
+
+  // The page shown or hidden (document.visibilityState).
+  setVisible(visible: boolean): void {
+    clearTimeout(this.hiddenTimer);
+    if (visible) this.watch(true);
+    else this.hiddenTimer = setTimeout(() => this.watch(false), HIDDEN_GRACE_MS);
+  }
+
+  private watch(on: boolean): void {
+    if (on === this.watching) return;
+    this.watching = on;
+    this.send(wire.watching(on));  // a new connection starts on; onWelcome says off again
   }
 
   send(frame: Uint8Array): void {
@@ -202,6 +220,7 @@ export class Connection {
     this.snapshots.clear();
     this.state = 'connected';
     ++this.welcomes;
+    if (!this.watching) this.send(wire.watching(false));
   }
 
   private onBallKinds(k: BallKinds): void {

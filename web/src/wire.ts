@@ -4,7 +4,7 @@
 
 import { Builder, ByteBuffer } from 'flatbuffers';
 import {
-  Ack, AddBalls, Hello, Message, Pause, Payload, Ping, PlayerInput, Reset, SetTimeScale, Step, Vec3f,
+  Ack, AddBalls, Hello, Message, Pause, Payload, Ping, PlayerInput, Reset, SetTimeScale, Step, Vec3f, Watching,
 } from 'fishtank-wire';
 
 // Set by esbuild from protocol/frame_codec.h's kProtocolVersion (web/CMakeLists.txt).
@@ -24,6 +24,10 @@ export const hello = (name: string, wantsPlayer: boolean): Uint8Array =>
 
 export const ack = (tick: number, wantKeyframe = false): Uint8Array =>
   frame(Payload.Ack, (b) => Ack.createAck(b, tick, wantKeyframe));
+
+// Off: no snapshots until on again.
+export const watching = (on: boolean): Uint8Array =>
+  frame(Payload.Watching, (b) => Watching.createWatching(b, on));
 
 export const playerInput = (sequence: number, v: readonly number[]): Uint8Array =>
   frame(Payload.PlayerInput, (b) => {
