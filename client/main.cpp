@@ -1,11 +1,9 @@
 // fishtank-client: a scripted test and load client (see --help).
 
-#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "client/options.h"
