@@ -118,9 +118,13 @@ void Connection::handle(const wire::Message& message) {
       const wire::PlayerGranted& g = *message.payload_as_PlayerGranted();
       player_id_ = g.player_id();
       may_control_ = g.may_control();
+      ahead_in_line_.reset();
       stats_.player_granted = true;
       break;
     }
+    case wire::Payload::InLine:
+      ahead_in_line_ = message.payload_as_InLine()->ahead();
+      break;
     case wire::Payload::Pong: {
       const auto now_us = static_cast<std::uint32_t>(
           std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - epoch_).count());

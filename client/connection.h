@@ -77,6 +77,8 @@ class Connection : public std::enable_shared_from_this<Connection> {
   bool closed() const { return closed_; }
   const std::string& close_reason() const { return close_reason_; }
   std::optional<std::uint32_t> player_id() const { return player_id_; }
+  // In line for a sphere: how many clients are before this one (InLine); empty when not in line.
+  std::optional<std::uint32_t> ahead_in_line() const { return ahead_in_line_; }
   std::uint32_t worker_threads() const { return worker_threads_; }  // from Welcome: the most a step may use
   // The newest snapshot's tank (Welcome's until a snapshot says).
   const TankBounds& tank() const { return tank_; }
@@ -110,6 +112,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
   bool closed_ = false;
   std::string close_reason_;
   std::optional<std::uint32_t> player_id_;
+  std::optional<std::uint32_t> ahead_in_line_;
   std::uint32_t worker_threads_ = 0;
   TankBounds tank_;
   bool may_control_ = false;

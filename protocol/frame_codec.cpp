@@ -55,6 +55,7 @@ bool accepted_by(wire::Payload type, Direction to) {
     case wire::Payload::Error:
     case wire::Payload::Pong:
     case wire::Payload::PlayerGranted:
+    case wire::Payload::InLine:
       return to == Direction::to_client;
     default:
       return false;
@@ -108,6 +109,7 @@ std::string check_values(const wire::Message& m) {
     case wire::Payload::Ping:
     case wire::Payload::Pong:
     case wire::Payload::PlayerGranted:
+    case wire::Payload::InLine:
     case wire::Payload::Pause:
     case wire::Payload::Watching:
     case wire::Payload::Ack:  // any tick: only the session knows which it sent
@@ -344,6 +346,11 @@ Frame encode_error(wire::ErrorCode code, std::string_view message) {
 Frame encode_player_granted(std::uint32_t player_id, bool may_control) {
   flatbuffers::FlatBufferBuilder b(64);
   return finish(b, wire::CreatePlayerGranted(b, player_id, may_control));
+}
+
+Frame encode_in_line(std::uint32_t ahead) {
+  flatbuffers::FlatBufferBuilder b(64);
+  return finish(b, wire::CreateInLine(b, ahead));
 }
 
 Frame encode_pong(std::uint32_t client_time_us) {

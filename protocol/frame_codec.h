@@ -119,6 +119,8 @@ Frame encode_error(wire::ErrorCode code, std::string_view message);
 Frame encode_pong(std::uint32_t client_time_us);
 // A sphere freed by another client, for this one that waited in line (may_control: under the policy, now).
 Frame encode_player_granted(std::uint32_t player_id, bool may_control);
+// This client's place in line for a sphere: `ahead` clients before it.
+Frame encode_in_line(std::uint32_t ahead);
 
 // ---- decoding ----
 enum class DecodeStatus {

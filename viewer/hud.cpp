@@ -130,7 +130,9 @@ void Hud::stats(const HudView& v) {
   else
     row(live, "Round trip", "-");
   ImGui::PushTextWrapPos(520.0f);
-  if (!v.observer && net.info && !net.info->has_player && !net.info->observing.empty())
+  if (!v.observer && net.info && !net.info->has_player && net.info->ahead_in_line)
+    row(live, "Player", "%s", in_line_text(*net.info->ahead_in_line).c_str());
+  else if (!v.observer && net.info && !net.info->has_player && !net.info->observing.empty())
     row(live, "Player", "observing: %s", net.info->observing.c_str());
   else if (v.observer || (net.info && !net.info->has_player))
     row(live, "Player", "observing");

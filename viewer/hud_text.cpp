@@ -71,4 +71,9 @@ std::string control_text(std::optional<bool> may_control, const std::string& pol
   return (*may_control ? "yours (P O R [ ] 1-4): " : "not yours: ") + policy;
 }
 
+std::string in_line_text(std::uint32_t ahead) {
+  if (ahead == 0) return "observing, next in line for a sphere";
+  return "observing, in line for a sphere: " + std::to_string(ahead) + " ahead of you";
+}
+
 }  // namespace fishtank::viewer

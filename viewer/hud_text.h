@@ -46,4 +46,8 @@ std::string step_text(float dt, float steps_per_contact, float tolerance);
 // answer no longer holds once the server frees this viewer's sphere: then the policy alone).
 std::string control_text(std::optional<bool> may_control, const std::string& policy);
 
+// The Player line while in line for a sphere (InLine): "observing, next in line for a sphere", or how many
+// are ahead.
+std::string in_line_text(std::uint32_t ahead);
+
 }  // namespace fishtank::viewer

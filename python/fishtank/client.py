@@ -17,7 +17,7 @@ import flatbuffers
 import numpy as np
 
 from fishtank._protocol import PROTOCOL_VERSION
-from fishtank.wire import (AddBalls, BallKinds, Error, ErrorCode, Hello, Message, Pause, Payload, Ping,
+from fishtank.wire import (AddBalls, BallKinds, Error, ErrorCode, Hello, InLine, Message, Pause, Payload, Ping,
                            PlayerGranted, PlayerInput, Pong, Reset, SetTimeScale, Snapshot as WireSnapshot, Step,
                            Vec3f, Welcome)
 
@@ -142,6 +142,7 @@ class Client:
         self.errors = []  # every FishtankError the server sent, oldest first
         self._unraised = []  # refusals not yet raised to the caller
         self.welcome = None
+        self.ahead_in_line = None  # in line for a sphere: how many clients are before this one (InLine)
         self._send(_frame(Payload.Payload.Hello, lambda b: self._hello(b, name, player)))
         deadline = time.monotonic() + timeout
         while self.welcome is None:
@@ -426,6 +427,11 @@ class Client:
             g.Init(table.Bytes, table.Pos)
             self.player_id = g.PlayerId()
             self.may_control = g.MayControl()
+            self.ahead_in_line = None
+        elif kind == Payload.Payload.InLine:
+            line = InLine.InLine()
+            line.Init(table.Bytes, table.Pos)
+            self.ahead_in_line = line.Ahead()
         elif kind == Payload.Payload.Pong:
             p = Pong.Pong()
             p.Init(table.Bytes, table.Pos)

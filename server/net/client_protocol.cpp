@@ -276,6 +276,10 @@ Outcome ClientProtocol::on_reply(const Reply& reply) {
     out.log = "given player sphere " + std::to_string(granted->player_id) + ", freed by another client";
     return out;
   }
+  if (const auto* in_line = std::get_if<InLineReply>(&reply.result)) {
+    out.replies.push_back(protocol::encode_in_line(in_line->ahead));
+    return out;
+  }
   if (const auto* control = std::get_if<ControlRefusedReply>(&reply.result)) {
     using Why = ControlRefusedReply::Why;
     const wire::ErrorCode code = control->why == Why::not_paused    ? wire::ErrorCode::not_paused

@@ -60,6 +60,10 @@ struct JoinedReply {
 struct PlayerGrantedReply {
   std::uint32_t player_id = 0;
 };
+// This client's place in line for a sphere changed (or it just joined the line).
+struct InLineReply {
+  std::uint32_t ahead = 0;
+};
 struct BallsAddedReply {
   std::string refusal;  // empty when all were accepted; else how many were and why no more
 };
@@ -78,7 +82,7 @@ struct ControlRefusedReply {
 
 struct Reply {
   std::uint32_t client_id = 0;
-  std::variant<JoinedReply, PlayerGrantedReply, BallsAddedReply, ControlRefusedReply> result;
+  std::variant<JoinedReply, PlayerGrantedReply, InLineReply, BallsAddedReply, ControlRefusedReply> result;
 };
 
 // Bounded, so a client flooding commands faster than the physics drains them

@@ -98,12 +98,14 @@ void PhysicsLink::apply(World& world, const Command& command) {
 
 void PhysicsLink::join(World& world, std::uint32_t client, bool wants_player) {
   JoinedReply joined;
-  if (wants_player && world.player_count() < options_.max_players) {
+  bool queued = false;
+  if (wants_player && options_.max_players == 0) {
+    joined.refusal = "this server has no player spheres (--max-players 0); you are observing";
+  } else if (wants_player && world.player_count() < options_.max_players) {
     joined.player_id = world.add_player();
     player_of_client_[client] = *joined.player_id;
-  } else if (wants_player && options_.max_players == 0) {
-    joined.refusal = "this server has no player spheres (--max-players 0); you are observing";
   } else if (wants_player) {
+    queued = true;
     waiting_for_player_.push_back(client);
     joined.refusal =
         (options_.max_players == 1 ? std::string("the one player sphere is taken")
@@ -111,12 +113,22 @@ void PhysicsLink::join(World& world, std::uint32_t client, bool wants_player) {
         " (--max-players); you are observing, in line for the next one freed";
   }
   reply_({client, std::move(joined)});
+  if (queued) tell_places_from(waiting_for_player_.size() - 1);
+}
+
+void PhysicsLink::tell_places_from(std::size_t first) {
+  for (std::size_t i = first; i < waiting_for_player_.size(); ++i)
+    reply_({waiting_for_player_[i], InLineReply{static_cast<std::uint32_t>(i)}});
 }
 
 void PhysicsLink::leave(World& world, std::uint32_t client) {
   // Leave ends a session, or frees an unmoved sphere (player_idle) while the client stays.
-  waiting_for_player_.erase(std::remove(waiting_for_player_.begin(), waiting_for_player_.end(), client),
-                            waiting_for_player_.end());
+  const auto waiting = std::find(waiting_for_player_.begin(), waiting_for_player_.end(), client);
+  if (waiting != waiting_for_player_.end()) {
+    const auto place = static_cast<std::size_t>(waiting - waiting_for_player_.begin());
+    waiting_for_player_.erase(waiting);
+    tell_places_from(place);
+  }
   const auto it = player_of_client_.find(client);
   if (it == player_of_client_.end()) return;
   world.remove_player(it->second);
@@ -127,6 +139,7 @@ void PhysicsLink::leave(World& world, std::uint32_t client) {
   const std::uint32_t player_id = world.add_player();
   player_of_client_[next] = player_id;
   reply_({next, PlayerGrantedReply{player_id}});
+  tell_places_from(0);
 }
 
 void PhysicsLink::refresh_figures(const World& world, Clock::time_point now) {

@@ -52,6 +52,8 @@ class PhysicsLink {
   void apply(World& world, const Command& command);
   void join(World& world, std::uint32_t client, bool wants_player);
   void leave(World& world, std::uint32_t client);
+  // Tells the clients in line from `first` on their place (each has moved up, or just joined).
+  void tell_places_from(std::size_t first);
   void publish_snapshot(const World& world, const LoopStatus& status);
   // Refreshes the plotted figures (energy, contacts) when they are older than kFiguresPeriod.
   void refresh_figures(const World& world, Clock::time_point now);

@@ -119,7 +119,7 @@ TEST_CASE("every message survives encode then decode with its values intact", "[
     const protocol::Frame scale = protocol::encode_set_time_scale(0.25f);
     CHECK(decode(scale, Direction::to_server).message->payload_as_SetTimeScale()->scale() == 0.25f);
   }
-  SECTION("BallKinds, AddBalls, Ping, Pong, Error, PlayerGranted, Watching") {
+  SECTION("BallKinds, AddBalls, Ping, Pong, Error, PlayerGranted, InLine, Watching") {
     const std::uint8_t kinds[] = {0, 1, 2, 1};
     // A decoded message points into its frame, so the frames outlive the checks.
     const protocol::Frame kinds_frame = protocol::encode_ball_kinds(10, kinds, 4);
@@ -139,6 +139,7 @@ TEST_CASE("every message survives encode then decode with its values intact", "[
     CHECK(g.message->payload_as_PlayerGranted()->player_id() == 7);
     CHECK(g.message->payload_as_PlayerGranted()->may_control());
     CHECK(decode(granted_frame, Direction::to_server).status == DecodeStatus::wrong_direction);
+    CHECK(decode(protocol::encode_in_line(3), Direction::to_client).message->payload_as_InLine()->ahead() == 3);
     const protocol::Frame watching_frame = protocol::encode_watching(false);
     auto w = decode(watching_frame, Direction::to_server);
     REQUIRE(w.ok());

@@ -273,6 +273,11 @@ TEST_CASE("more clients than --max-players wait in line, told so, and get freed 
   REQUIRE(has_error(*second, "player_limit"));
   CHECK_THAT(second->stats().errors.front(), Catch::Contains("in line for the next one freed"));
   CHECK(observer->stats().errors.empty());  // it asked for none, so it is not in line
+  CHECK_FALSE(observer->ahead_in_line().has_value());
+  // Each in line knows its place.
+  REQUIRE(clients.wait_until([&] { return quitter->ahead_in_line() == 2u; }, std::chrono::seconds(5)));
+  CHECK(second->ahead_in_line() == 0u);
+  CHECK(third->ahead_in_line() == 1u);
 
   // One in line that leaves gives up its place: the sphere skips it.
   quitter->close();
@@ -280,7 +285,9 @@ TEST_CASE("more clients than --max-players wait in line, told so, and get freed 
   first->close();
   REQUIRE(clients.wait_until([&] { return second->player_id().has_value(); }, std::chrono::seconds(5)));
   CHECK(second->stats().player_granted);
+  CHECK_FALSE(second->ahead_in_line().has_value());
   CHECK_FALSE(third->player_id().has_value());
+  REQUIRE(clients.wait_until([&] { return third->ahead_in_line() == 0u; }, std::chrono::seconds(5)));
   CHECK(second->may_control());  // the default policy: players may control
 
   // The granted sphere is second's to move.
@@ -339,6 +346,20 @@ TEST_CASE("through joins and leaves in any order, every sphere has one holder an
                              std::chrono::seconds(10)));
   const std::vector<std::uint32_t> held = holders();
   CHECK(std::adjacent_find(held.begin(), held.end()) == held.end());  // no sphere with two holders
+  // Those in line hold the places 0, 1, 2, ... each once.
+  const auto places = [&] {
+    std::vector<std::uint32_t> ahead;
+    for (auto& c : live)
+      if (!c->player_id()) ahead.push_back(c->ahead_in_line().value_or(999));
+    std::sort(ahead.begin(), ahead.end());
+    return ahead;
+  };
+  const auto first_places = [](std::size_t n) {
+    std::vector<std::uint32_t> v(n);
+    for (std::size_t i = 0; i < n; ++i) v[i] = static_cast<std::uint32_t>(i);
+    return v;
+  };
+  CHECK(clients.wait_until([&] { return places() == first_places(live.size() - expected); }, std::chrono::seconds(5)));
   // Closing every holder hands each sphere on down the line until the line is empty.
   while (!live.empty()) {
     auto holder = std::find_if(live.begin(), live.end(), [](auto& c) { return c->player_id().has_value(); });
@@ -348,6 +369,8 @@ TEST_CASE("through joins and leaves in any order, every sphere has one holder an
     const std::size_t now_expected = std::min<std::size_t>(live.size(), kMaxPlayers);
     REQUIRE(clients.wait_until([&] { return holders().size() == now_expected && spheres() == holders(); },
                                std::chrono::seconds(10)));
+    CHECK(clients.wait_until([&] { return places() == first_places(live.size() - now_expected); },
+                             std::chrono::seconds(5)));
   }
   CHECK(spheres().empty());
 }

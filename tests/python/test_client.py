@@ -128,6 +128,7 @@ def test_a_client_in_line_for_a_sphere_gets_the_one_its_holder_frees_and_can_mov
         waiting.snapshot()  # the refusal follows the Welcome, before any snapshot
         assert [e.code for e in waiting.errors] == ["player_limit"]
         assert "in line for the next one freed" in waiting.errors[0].message
+        assert waiting.ahead_in_line == 0
         with pytest.raises(FishtankError) as none:
             waiting.move((1.0, 0.0, 0.0))
         assert none.value.code == "no_player"
@@ -136,6 +137,7 @@ def test_a_client_in_line_for_a_sphere_gets_the_one_its_holder_frees_and_can_mov
         while waiting.player_id is None and time.monotonic() < deadline:
             waiting.snapshot()
         assert waiting.player_id is not None and waiting.may_control
+        assert waiting.ahead_in_line is None
         start = waiting.snapshot()
         mine = list(start.player_ids).index(waiting.player_id)
         waiting.move((4.0, 0.0, 0.0))

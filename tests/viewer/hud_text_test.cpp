@@ -90,6 +90,11 @@ TEST_CASE("the control line says first whether this viewer may, then the server'
   CHECK(control_text(std::nullopt, "clients with a player sphere may") == "clients with a player sphere may");
 }
 
+TEST_CASE("in line for a sphere, the Player line says next, or how many are ahead") {
+  CHECK(in_line_text(0) == "observing, next in line for a sphere");
+  CHECK(in_line_text(3) == "observing, in line for a sphere: 3 ahead of you");
+}
+
 TEST_CASE("while no server answers, the hint is the exact command that starts one at the address tried") {
   CHECK(server_command_hint("127.0.0.1", "7913") ==
         "To start a server here: build/server/fishtank-server --port 7913");

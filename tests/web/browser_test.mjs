@@ -235,12 +235,14 @@ test('where every player sphere is taken, the page observes in line, says why, o
     await p.goto(full.url);
     const s = await waitForState(p, (st) => st.connection === 'connected' && st.serverBalls > 0, 'a snapshot');
     assert.equal(s.hasPlayer, false);
+    const why = await waitForHud(p, (t) => /player_limit/.test(t));
+    assert.match(why, /player_limit: .*in line for the next one freed/, 'the server\'s words, below the statistics');
     await p.touchscreen.tap(400, 200);
     const pad = await waitForState(p, (st) => st.touchPadShown, 'the pad shown after a touch');
     assert.equal(pad.touchStickShown, false, 'an observer\'s pad has no stick: it has no sphere to move');
     await p.keyboard.press('KeyP');
     const hud = await waitForHud(p, (t) => /not_permitted/.test(t));
-    assert.match(hud, /Playerobserving: player_limit: .*in line for the next one freed/);
+    assert.match(hud, /Playerobserving, next in line for a sphere/);
     assert.doesNotMatch(hud, /reload the page/, 'one in line needs no reload: the server hands it the next sphere');
     assert.match(hud, /Controlnot yours/);
     assert.match(hud, /not_permitted/);

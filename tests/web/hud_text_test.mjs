@@ -6,7 +6,7 @@ import assert from 'node:assert/strict';
 import { test } from 'node:test';
 import { need } from './harness.mjs';
 
-const { clockStepMs, controlText, roundTripText } = await import(need('FISHTANK_WEB_MODULE'));
+const { clockStepMs, controlText, inLineText, roundTripText } = await import(need('FISHTANK_WEB_MODULE'));
 
 // A clock that reads `step`-coarsened time and advances `tick` ms per read, like a browser's performance.now().
 const coarseClock = (step, tick = 0.013) => {
@@ -44,4 +44,9 @@ test('the control line says whether this page may, and once the server freed its
   assert.equal(controlText(true, 'players may'), 'yours (P O R [ ] 1-4): players may');
   assert.equal(controlText(false, 'observers may not'), 'not yours: observers may not');
   assert.equal(controlText(null, 'clients with a player sphere may'), 'clients with a player sphere may');
+});
+
+test('in line for a sphere, the Player line says next, or how many are ahead (the viewer\'s twin words)', () => {
+  assert.equal(inLineText(0), 'observing, next in line for a sphere');
+  assert.equal(inLineText(3), 'observing, in line for a sphere: 3 ahead of you');
 });

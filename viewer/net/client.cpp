@@ -203,6 +203,7 @@ void NetClient::on_frame() {
       auto playing = std::make_shared<ServerInfo>(*info_);
       playing->has_player = true;
       playing->observing.clear();
+      playing->ahead_in_line.reset();
       playing->player_id = g.player_id();
       playing->may_control = g.may_control();
       info_ = playing;
@@ -211,6 +212,13 @@ void NetClient::on_frame() {
         s.notice_time = steady_seconds();
         s.info = info_;
       });
+    }
+    case wire::Payload::InLine: {
+      if (!connected_) return lose("the server gave a place in line before Welcome");
+      auto waiting = std::make_shared<ServerInfo>(*info_);
+      waiting->ahead_in_line = m.payload_as_InLine()->ahead();
+      info_ = waiting;
+      return update_status([&](ConnectionStatus& s) { s.info = info_; });
     }
     case wire::Payload::Pong: {
       auto now_us = static_cast<std::uint32_t>((steady_seconds() - ping_epoch_) * 1e6);

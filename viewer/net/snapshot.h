@@ -31,6 +31,7 @@ struct ServerInfo {
   bool has_player = false;
   // Without a sphere, the server's reason (player_limit: in line for one; player_idle: it was freed).
   std::string observing;
+  std::optional<std::uint32_t> ahead_in_line;  // in line for a sphere: clients before this viewer (InLine)
 };
 
 struct PlayerState {

@@ -1,7 +1,9 @@
 // The statistics panel and the help overlay, as HTML over the canvas. Figures
 // that came from the server are greyed, with the reason, when the link is down.
 
-import { clockStepMs, controlText, freshnessNote, roundTripText, stepText, threadsText, timeScaleText } from './hud_text';
+import {
+  clockStepMs, controlText, freshnessNote, inLineText, roundTripText, stepText, threadsText, timeScaleText,
+} from './hud_text';
 import type { Connection } from './net';
 
 const HELP: [string, string][] = [
@@ -90,6 +92,7 @@ export class Hud {
     if (info) {
       row('Player', info.hasPlayer ? 'yours is the white sphere with the amber ring'
         : v.observerAsked ? 'observing, as asked (?observer)'
+          : net.inLine && net.aheadInLine >= 0 ? inLineText(net.aheadInLine)
           // One in line gets the next sphere freed; one whose sphere was freed asks again by a reload.
           : `observing: ${net.observing || 'the server gave no player sphere'}${net.inLine ? '' : '; reload the page to ask for one again'}`);
       row('Control', controlText(info.mayControl, info.controlPolicy));

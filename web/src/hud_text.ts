@@ -47,6 +47,11 @@ export function controlText(mayControl: boolean | null, policy: string): string 
   return (mayControl ? 'yours (P O R [ ] 1-4): ' : 'not yours: ') + policy;
 }
 
+// The Player line while in line for a sphere (InLine): next, or how many are ahead.
+export function inLineText(ahead: number): string {
+  return ahead === 0 ? 'observing, next in line for a sphere' : `observing, in line for a sphere: ${ahead} ahead of you`;
+}
+
 // The smallest step performance.now() takes here, over `increments` of its steps (at most forMs, and a bounded
 // number of reads): browsers coarsen it against timing attacks, by 0.1 ms in most pages and up to 1 ms or more in
 // some browsers and privacy settings. Several steps, not a fixed time: on a busy machine the page may lose the

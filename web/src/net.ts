@@ -4,7 +4,9 @@
 // deltas; the player's velocity 30 times a second; a Ping a second. When the
 // socket closes it tries again every second, for as long as the page is open.
 
-import { BallKinds, Error as WireError, ErrorCode, Message, Payload, PlayerGranted, Pong, Snapshot, Welcome } from 'fishtank-wire';
+import {
+  BallKinds, Error as WireError, ErrorCode, InLine, Message, Payload, PlayerGranted, Pong, Snapshot, Welcome,
+} from 'fishtank-wire';
 import { ReceivedSnapshots } from './delta';
 import type { BallKind } from './render';
 import { Frame, Player, SnapshotBuffer } from './snapshots';
@@ -56,6 +58,7 @@ export class Connection {
   bytes = 0;  // received, in all
   observing = '';  // the server's reason when this page has no player sphere, if it gave one
   inLine = false;  // refused a sphere for want of one: the server gives this page the next one freed
+  aheadInLine = -1;  // while in line, how many clients are before this page (InLine); -1: not told
   spheresGranted = 0;  // spheres freed by others that came to this page (PlayerGranted)
   private notice = '';
   private noticeTime = 0;
@@ -175,9 +178,13 @@ export class Connection {
         this.info.mayControl = g.mayControl();
         this.observing = '';
         this.inLine = false;
+        this.aheadInLine = -1;
         ++this.spheresGranted;
         return this.say('a player sphere was freed and is yours now (the white one with the amber ring)');
       }
+      case Payload.InLine:
+        this.aheadInLine = (m.payload(new InLine()) as InLine).ahead();
+        return;
       case Payload.Pong: {
         const p = m.payload(new Pong()) as Pong;
         this.rttMs = ((Math.round(seconds() * 1e6) - p.clientTimeUs()) >>> 0) / 1000;
@@ -215,6 +222,7 @@ export class Connection {
     };
     this.observing = '';
     this.inLine = false;
+    this.aheadInLine = -1;
     this.kinds = new Uint8Array(0);
     this.received.clear();
     this.snapshots.clear();
