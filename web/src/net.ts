@@ -59,14 +59,13 @@ export class Connection {
   observing = '';  // the server's reason when this page has no player sphere, if it gave one
   inLine = false;  // refused a sphere for want of one: the server gives this page the next one freed
   aheadInLine = -1;  // while in line, how many clients are before this page (InLine); -1: not told
-  spheresGranted = 0;  // spheres freed by others that came to this page (PlayerGranted)
+  watching = true;  // whether the server is asked for snapshots (Watching)
   private notice = '';
   private noticeTime = 0;
   private socket: WebSocket | null = null;
   private kinds = new Uint8Array(0);
   private readonly received = new ReceivedSnapshots();
   private inputSequence = 0;
-  watching = true;  // whether the server is asked for snapshots (Watching)
   private hiddenTimer: ReturnType<typeof setTimeout> | undefined;
   private snapshotsThisSecond = 0;
   private bytesThisSecond = 0;
@@ -161,7 +160,8 @@ export class Connection {
         const text = `${ErrorCode[e.code()] ?? `error ${e.code()}`}: ${e.message() ?? ''}`;
         // Why this page observes stays on the HUD, not only for a notice's few seconds.
         if (e.code() === ErrorCode.player_limit || e.code() === ErrorCode.player_idle) this.observing = text;
-        this.inLine = e.code() === ErrorCode.player_limit || (this.inLine && e.code() !== ErrorCode.player_idle);
+        if (e.code() === ErrorCode.player_limit) this.inLine = true;
+        if (e.code() === ErrorCode.player_idle) this.inLine = false;
         // The sphere was freed: from now on this page observes.
         if (e.code() === ErrorCode.player_idle && this.info) {
           this.info.hasPlayer = false;
@@ -179,7 +179,6 @@ export class Connection {
         this.observing = '';
         this.inLine = false;
         this.aheadInLine = -1;
-        ++this.spheresGranted;
         return this.say('a player sphere was freed and is yours now (the white one with the amber ring)');
       }
       case Payload.InLine:
