@@ -198,8 +198,14 @@ test('a page hidden over two seconds asks for no snapshots, and shown again deco
   await sleep(1000);
   assert.equal((await waitForState(page, () => true, 'state')).watching, true, 'a glance away keeps the snapshots');
   const off = await waitForState(page, (st) => !st.watching, 'watching off after the grace');
-  await sleep(500);  // a snapshot already sent may still arrive
-  const quiet = await waitForState(page, () => true, 'state');
+  // Snapshots already on their way still arrive: wait for a quiet half second (a busy machine may take longer).
+  let quiet = await waitForState(page, () => true, 'state');
+  for (let tries = 0; tries < 10; ++tries) {
+    await sleep(500);
+    const now = await waitForState(page, () => true, 'state');
+    if (now.decoded === quiet.decoded) break;
+    quiet = now;
+  }
   await sleep(1500);
   const later = await waitForState(page, () => true, 'state');
   assert.equal(later.decoded, quiet.decoded, 'no snapshot decoded while hidden');
