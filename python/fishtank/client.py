@@ -169,6 +169,20 @@ class Client:
         s, self._newest = self._newest, None
         return s
 
+    def wait_for_player(self, timeout=None):
+        """Waits until this client holds a player sphere and returns its id: at once where it has one, else once
+        a sphere another client frees comes to it, first in line. Raises FishtankError "no_player" where it is
+        not in line (it asked for none, or the server has none) and "timeout" where none came in time (default:
+        the client's timeout)."""
+        deadline = time.monotonic() + (self.timeout if timeout is None else timeout)
+        while self.player_id is None:
+            # The refusal and the place in line come before any snapshot, so a snapshot without them means no line.
+            if self.ahead_in_line is None and self._last is not None:
+                raise FishtankError("no_player", "this client is not in line for a player sphere" +
+                                    self._last_error_text())
+            self._read_one(deadline)
+        return self.player_id
+
     def move(self, velocity):
         """Sets the player sphere's velocity (metres per second, x y z); it keeps it until the next move()."""
         if self.player_id is None:

@@ -132,19 +132,34 @@ def test_a_client_in_line_for_a_sphere_gets_the_one_its_holder_frees_and_can_mov
         with pytest.raises(FishtankError) as none:
             waiting.move((1.0, 0.0, 0.0))
         assert none.value.code == "no_player"
+        with pytest.raises(FishtankError) as not_yet:
+            waiting.wait_for_player(timeout=0.5)  # the holder has not left
+        assert not_yet.value.code == "timeout"
         holder.close()
-        deadline = time.monotonic() + 10
-        while waiting.player_id is None and time.monotonic() < deadline:
-            waiting.snapshot()
-        assert waiting.player_id is not None and waiting.may_control
+        granted = waiting.wait_for_player()
+        assert granted is not None and granted == waiting.player_id
+        assert waiting.may_control
         assert waiting.ahead_in_line is None
-        start = waiting.snapshot()
+        start, deadline = waiting.snapshot(), time.monotonic() + 10
+        while waiting.player_id not in start.player_ids and time.monotonic() < deadline:
+            start = waiting.snapshot()  # one taken before the grant may still have been waiting to be read
         mine = list(start.player_ids).index(waiting.player_id)
         waiting.move((4.0, 0.0, 0.0))
         time.sleep(1.0)
         moved = waiting.snapshot()
         assert moved.player_positions[list(moved.player_ids).index(waiting.player_id)][0] > \
             start.player_positions[mine][0] + 2.0
+
+
+def test_waiting_for_a_sphere_outside_the_line_says_so_at_once(start_server):
+    server = start_server("--balls", "0", "--max-players", "0")
+    with Client("127.0.0.1", server.port) as refused, Client("127.0.0.1", server.port, player=False) as watcher:
+        for client in (refused, watcher):
+            started = time.monotonic()
+            with pytest.raises(FishtankError) as none:
+                client.wait_for_player(timeout=10)
+            assert none.value.code == "no_player" and time.monotonic() - started < 5
+        assert "--max-players 0" in str(refused.errors[0])
 
 
 def test_refusals_raise_with_the_servers_reason_and_the_connection_keeps_working(start_server):
