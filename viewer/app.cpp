@@ -193,6 +193,7 @@ int run_viewer(const ViewerOptions& opt) {
     int frames_since_snapshot = 0;
     std::string reported_error;
     const double started = steady_seconds();
+    bool was_minimised = false;
 
     while (!glfwWindowShouldClose(window)) {
       glfwPollEvents();
@@ -215,6 +216,14 @@ int run_viewer(const ViewerOptions& opt) {
 
       input.drive_camera(camera);
       if (!opt.observer) net.set_velocity(input.movement(camera) * kPlayerSpeed);
+      // A minimised window draws nothing: it asks for no snapshots and waits for events instead.
+      const bool minimised = glfwGetWindowAttrib(window, GLFW_ICONIFIED) != 0;
+      if (minimised != was_minimised) net.set_watching(!minimised);
+      was_minimised = minimised;
+      if (minimised) {
+        glfwWaitEventsTimeout(0.25);
+        continue;
+      }
 
       // The pair first, then the status: a snapshot of a new connection is
       // only ever pushed after that connection's status (and ball kinds).

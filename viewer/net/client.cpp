@@ -59,6 +59,14 @@ void NetClient::add_balls(std::uint32_t count) {
   });
 }
 
+void NetClient::set_watching(bool on) {
+  asio::post(io_, [this, on] {
+    if (on == watching_) return;
+    watching_ = on;
+    if (connected_) send(protocol::encode_watching(on));
+  });
+}
+
 void NetClient::send_command(protocol::Frame frame) {
   asio::post(io_, [this, frame = std::move(frame)]() mutable {
     if (connected_) send(std::move(frame));
@@ -254,6 +262,7 @@ void NetClient::on_welcome(const wire::Welcome& w) {
   kinds_ = std::make_shared<std::vector<std::uint8_t>>();
   received_.clear();
   connected_ = true;
+  if (!watching_) send(protocol::encode_watching(false));  // a new connection starts on
   snapshots_.clear();
   update_status([&](ConnectionStatus& s) {
     s.state = ConnectionStatus::State::connected;

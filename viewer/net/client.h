@@ -52,6 +52,8 @@ class NetClient {
 
   void set_velocity(Vec3 velocity);
   void add_balls(std::uint32_t count);
+  // Off: the server sends no snapshots until on again (a minimised window draws nothing).
+  void set_watching(bool on);
   // Sends a frame as it is (the sandbox's controls), if connected.
   void send_command(protocol::Frame frame);
   ConnectionStatus status() const;
@@ -89,6 +91,7 @@ class NetClient {
   // complete late recognise themselves as stale.
   std::uint64_t generation_ = 0;
   bool connected_ = false;  // Welcome received on the current connection
+  bool watching_ = true;    // what the server was last asked (Watching); every connection starts on
   std::uint8_t prefix_[protocol::kLengthPrefixBytes] = {};
   protocol::Frame frame_;
   std::deque<protocol::Frame> write_queue_;  // front is in flight
