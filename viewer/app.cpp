@@ -123,6 +123,8 @@ void print_summary(const FrameStats& stats, const ConnectionStatus& s, std::uint
   if (waiting > 0)
     std::fprintf(stderr, "; before them %llu frames waiting for the server",
                  static_cast<unsigned long long>(waiting));
+  if (stats.minimised_seconds() > 0.0)
+    std::fprintf(stderr, "; %.1f s minimised, not counted", stats.minimised_seconds());
   std::fprintf(stderr, "\n");
 }
 
@@ -194,6 +196,7 @@ int run_viewer(const ViewerOptions& opt) {
     std::string reported_error;
     const double started = steady_seconds();
     bool was_minimised = false;
+    double minimised_at = 0.0;
 
     while (!glfwWindowShouldClose(window)) {
       glfwPollEvents();
@@ -218,7 +221,13 @@ int run_viewer(const ViewerOptions& opt) {
       if (!opt.observer) net.set_velocity(input.movement(camera) * kPlayerSpeed);
       // A minimised window draws nothing: it asks for no snapshots and waits for events instead.
       const bool minimised = glfwGetWindowAttrib(window, GLFW_ICONIFIED) != 0;
-      if (minimised != was_minimised) net.set_watching(!minimised);
+      if (minimised != was_minimised) {
+        net.set_watching(!minimised);
+        if (minimised)
+          minimised_at = frame_start;
+        else
+          stats.not_drawn(minimised_at, frame_start);
+      }
       was_minimised = minimised;
       if (minimised) {
         glfwWaitEventsTimeout(0.25);

@@ -24,4 +24,9 @@ void FrameStats::frame_done(double now, double cpu_seconds, bool scene) {
   cpu_ms_ = static_cast<float>(1e3 * cpu / intervals);
 }
 
+void FrameStats::not_drawn(double from, double to) {
+  // Before the first scene frame the summary's span has not begun.
+  if (total_frames_ > 0 && to > from) minimised_ += to - from;
+}
+
 }  // namespace fishtank::viewer

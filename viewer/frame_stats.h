@@ -24,7 +24,11 @@ class FrameStats {
   // one.
   std::uint64_t all_frames() const { return all_frames_; }
   double all_seconds() const { return all_last_ - all_first_; }
-  double total_seconds() const { return last_ - first_; }  // first to last scene frame
+  // A minimised window drew nothing from `from` to `to`: that time is left out of the summary's rate.
+  void not_drawn(double from, double to);
+  double minimised_seconds() const { return minimised_; }
+  // First to last scene frame, less the time minimised in between.
+  double total_seconds() const { return last_ - first_ - minimised_; }
   double mean_cpu_ms() const {
     return total_frames_ ? 1e3 * total_cpu_ / static_cast<double>(total_frames_) : 0.0;
   }
@@ -39,6 +43,7 @@ class FrameStats {
   std::uint64_t total_frames_ = 0, all_frames_ = 0;
   double total_cpu_ = 0.0;
   double first_ = 0.0, last_ = 0.0, all_first_ = 0.0, all_last_ = 0.0;
+  double minimised_ = 0.0;
 };
 
 }  // namespace fishtank::viewer

@@ -32,6 +32,17 @@ TEST_CASE("the exit summary counts only frames that drew the scene") {
   CHECK(stats.mean_cpu_ms() == Approx(1.0));
 }
 
+TEST_CASE("time minimised is left out of the summary's span, and before the first scene frame nothing is") {
+  FrameStats stats;
+  stats.not_drawn(0.0, 0.5);  // minimised before anything was drawn: the span has not begun
+  for (int i = 0; i <= 30; ++i) stats.frame_done(1.0 + i / 30.0, 0.0, true);  // 2.0 s
+  stats.not_drawn(2.0, 7.0);
+  for (int i = 1; i <= 30; ++i) stats.frame_done(7.0 + i / 30.0, 0.0, true);  // to 8.0 s
+  CHECK(stats.minimised_seconds() == Approx(5.0));
+  CHECK(stats.total_seconds() == Approx(2.0));  // 1 to 8 s, less 5 s minimised
+  CHECK(stats.total_frames() == 61);
+}
+
 TEST_CASE("frames drawn while waiting for a server are counted apart, for a viewer that never connects") {
   FrameStats stats;
   for (int i = 0; i <= 60; ++i) stats.frame_done(i / 30.0, 0.0, false);  // 2 s at 30 fps, nothing to draw
