@@ -130,17 +130,18 @@ void Hud::stats(const HudView& v) {
   else
     row(live, "Round trip", "-");
   ImGui::PushTextWrapPos(520.0f);
-  if (!v.observer && net.info && !net.info->has_player && net.info->ahead_in_line)
-    row(live, "Player", "%s", in_line_text(*net.info->ahead_in_line).c_str());
-  else if (!v.observer && net.info && !net.info->has_player && !net.info->observing.empty())
-    row(live, "Player", "observing: %s", net.info->observing.c_str());
-  else if (v.observer || (net.info && !net.info->has_player))
+  const ServerInfo* info = net.info.get();
+  // Refused a sphere it asked for, or its sphere freed: the server said why, or where it waits.
+  const bool refused = !v.observer && info && !info->has_player;
+  if (refused && info->ahead_in_line)
+    row(live, "Player", "%s", in_line_text(*info->ahead_in_line).c_str());
+  else if (refused && !info->observing.empty())
+    row(live, "Player", "observing: %s", info->observing.c_str());
+  else if (v.observer || refused)
     row(live, "Player", "observing");
   else
     row(live, "Player", "yours is the white sphere with the amber ring");
-  if (const ServerInfo* info = net.info.get()) {
-    row(live, "Control", "%s", control_text(info->may_control, info->control_policy).c_str());
-  }
+  if (info) row(live, "Control", "%s", control_text(info->may_control, info->control_policy).c_str());
   ImGui::PopTextWrapPos();
   if (!live) ImGui::TextColored(kWarn, "%s", fresh.note.c_str());
   ImGui::TextColored(kDim, "H: help");

@@ -67,6 +67,18 @@ void NetClient::set_watching(bool on) {
   });
 }
 
+void NetClient::change_info(const std::function<void(ServerInfo&)>& change, std::string notice) {
+  auto changed = std::make_shared<ServerInfo>(*info_);
+  change(*changed);
+  info_ = changed;
+  update_status([&](ConnectionStatus& s) {
+    s.info = info_;
+    if (notice.empty()) return;
+    s.notice = std::move(notice);
+    s.notice_time = steady_seconds();
+  });
+}
+
 void NetClient::send_command(protocol::Frame frame) {
   asio::post(io_, [this, frame = std::move(frame)]() mutable {
     if (connected_) send(std::move(frame));
@@ -185,49 +197,42 @@ void NetClient::on_frame() {
       return on_snapshot(*m.payload_as_Snapshot());
     case wire::Payload::Error: {
       const wire::Error& e = *m.payload_as_Error();
-      std::string text = server_text(e.message()->str());  // present: decode_frame checks
+      const std::string text = server_text(e.message()->str());  // present: decode_frame checks
       // Why this viewer observes stays on the HUD's Player row, not only for a notice's few seconds.
-      if ((e.code() == wire::ErrorCode::player_limit || e.code() == wire::ErrorCode::player_idle) && info_) {
-        auto observing = std::make_shared<ServerInfo>(*info_);
-        observing->observing = text;
-        // The sphere was freed: from now on this viewer observes. The Welcome's answer was a
-        // player's; the policy decides an observer's.
-        if (e.code() == wire::ErrorCode::player_idle) {
-          observing->has_player = false;
-          observing->may_control.reset();
-        }
-        info_ = observing;
-      }
+      if (info_ && (e.code() == wire::ErrorCode::player_limit || e.code() == wire::ErrorCode::player_idle))
+        return change_info(
+            [&](ServerInfo& info) {
+              info.observing = text;
+              // The sphere was freed: from now on this viewer observes. The Welcome's answer was a
+              // player's; the policy decides an observer's.
+              if (e.code() == wire::ErrorCode::player_idle) {
+                info.has_player = false;
+                info.may_control.reset();
+              }
+            },
+            "server: " + text);
       return update_status([&](ConnectionStatus& s) {
         s.notice = "server: " + text;
         s.notice_time = steady_seconds();
-        s.info = info_;
       });
     }
     case wire::Payload::PlayerGranted: {
       if (!connected_) return lose("the server granted a player sphere before Welcome");
       // Another client's sphere was freed and this viewer, in line for one, has it now.
       const wire::PlayerGranted& g = *m.payload_as_PlayerGranted();
-      auto playing = std::make_shared<ServerInfo>(*info_);
-      playing->has_player = true;
-      playing->observing.clear();
-      playing->ahead_in_line.reset();
-      playing->player_id = g.player_id();
-      playing->may_control = g.may_control();
-      info_ = playing;
-      return update_status([&](ConnectionStatus& s) {
-        s.notice = "server: a player sphere was freed and is yours now (the white one with the amber ring)";
-        s.notice_time = steady_seconds();
-        s.info = info_;
-      });
+      return change_info(
+          [&](ServerInfo& info) {
+            info.has_player = true;
+            info.observing.clear();
+            info.ahead_in_line.reset();
+            info.player_id = g.player_id();
+            info.may_control = g.may_control();
+          },
+          "server: a player sphere was freed and is yours now (the white one with the amber ring)");
     }
-    case wire::Payload::InLine: {
+    case wire::Payload::InLine:
       if (!connected_) return lose("the server gave a place in line before Welcome");
-      auto waiting = std::make_shared<ServerInfo>(*info_);
-      waiting->ahead_in_line = m.payload_as_InLine()->ahead();
-      info_ = waiting;
-      return update_status([&](ConnectionStatus& s) { s.info = info_; });
-    }
+      return change_info([&](ServerInfo& info) { info.ahead_in_line = m.payload_as_InLine()->ahead(); });
     case wire::Payload::Pong: {
       auto now_us = static_cast<std::uint32_t>((steady_seconds() - ping_epoch_) * 1e6);
       std::uint32_t rtt_us = now_us - m.payload_as_Pong()->client_time_us();  // modulo 2^32

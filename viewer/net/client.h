@@ -17,6 +17,7 @@
 #include <boost/asio.hpp>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -76,6 +77,8 @@ class NetClient {
     std::lock_guard lock(status_mutex_);
     f(status_);
   }
+  // The render thread holds ServerInfo read-only: a change publishes a changed copy, with a notice if given.
+  void change_info(const std::function<void(ServerInfo&)>& change, std::string notice = {});
 
   std::string host_, port_;
   bool wants_player_;
