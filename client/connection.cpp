@@ -11,7 +11,7 @@ namespace fishtank::client {
 namespace asio = boost::asio;
 
 Connection::Connection(asio::io_context& io, std::string name, bool wants_player)
-    : socket_(io), name_(std::move(name)), wants_player_(wants_player) {}
+    : socket_(io), name_(std::move(name)), wants_player_(wants_player), read_pause_(io) {}
 
 void Connection::start(const asio::ip::tcp::endpoint& server, std::uint32_t version) {
   socket_.async_connect(server, [this, self = shared_from_this(), version](boost::system::error_code ec) {
@@ -41,6 +41,7 @@ void Connection::close(const std::string& reason) {
   boost::system::error_code ignored;
   socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
   socket_.close(ignored);
+  read_pause_.cancel();
 }
 
 void Connection::fail(const std::string& reason) {
@@ -61,7 +62,10 @@ void Connection::do_write() {
 }
 
 void Connection::do_read() {
-  socket_.async_read_some(asio::buffer(read_buffer_),
+  // A limited rate reads 20 ms of it at a time, so the bytes arrive as evenly as over a slow link.
+  const std::size_t chunk =
+      read_rate_ > 0.0 ? std::clamp<std::size_t>(read_rate_ / 50.0, 1024, read_buffer_.size()) : read_buffer_.size();
+  socket_.async_read_some(asio::buffer(read_buffer_.data(), chunk),
                           [this, self = shared_from_this()](boost::system::error_code ec, std::size_t n) {
                             if (ec)
                               return fail(ec == asio::error::eof ? "the server closed the connection" : ec.message());
@@ -75,7 +79,13 @@ void Connection::do_read() {
                               }
                               handle(*frame->message);
                             }
-                            if (!closed_) do_read();
+                            if (closed_) return;
+                            if (read_rate_ <= 0.0) return do_read();
+                            read_pause_.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                std::chrono::duration<double>(n / read_rate_)));
+                            read_pause_.async_wait([this, self](boost::system::error_code e) {
+                              if (!e && !closed_) do_read();
+                            });
                           });
 }
 

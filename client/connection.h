@@ -70,6 +70,8 @@ class Connection : public std::enable_shared_from_this<Connection> {
   void send_ping();
   // Off: no Ack is sent, so every snapshot comes in full (as before deltas).
   void acknowledge_snapshots(bool on) { acknowledge_ = on; }
+  // Reads at most this many bytes a second, as over a slow link; 0: as fast as they come.
+  void limit_read_rate(double bytes_per_s) { read_rate_ = bytes_per_s; }
   // The reason is kept unless an earlier one was (the server's, or a failure's).
   void close(const std::string& reason = "closed by the client");
 
@@ -102,6 +104,8 @@ class Connection : public std::enable_shared_from_this<Connection> {
   bool wants_player_;
   protocol::FrameReader reader_{protocol::Direction::to_client};
   std::vector<std::uint8_t> read_buffer_ = std::vector<std::uint8_t>(64 * 1024);
+  double read_rate_ = 0.0;                // bytes a second; 0: no limit
+  boost::asio::steady_timer read_pause_;  // between reads, while the rate is limited
   std::deque<protocol::Frame> outgoing_;
   bool write_in_flight_ = false;
   bool acknowledge_ = true;

@@ -30,12 +30,14 @@ int main(int argc, char** argv) {
                                       {"snapshots", r.snapshots},
                                       {"keyframes", r.keyframes},
                                       {"bytes", r.bytes},
-                                      {"bytes_per_ball", bytes_per_ball}}
+                                      {"bytes_per_ball", bytes_per_ball},
+                                      {"rtt_ms", r.rtt_ms ? nlohmann::json(*r.rtt_ms) : nlohmann::json()}}
                            .dump()
                     << std::endl;
         else
           std::cout << "t " << r.t << " s: " << r.snapshots << " snapshots (" << r.keyframes << " in full), " << r.bytes
-                    << " bytes, " << bytes_per_ball << " bytes per ball per snapshot\n";
+                    << " bytes, " << bytes_per_ball << " bytes per ball per snapshot, rtt "
+                    << (r.rtt_ms ? std::to_string(*r.rtt_ms) + " ms" : "(no Pong came back)") << "\n";
       });
   if (!s.connect_error.empty()) {
     std::cerr << "fishtank-client: no connection to "

@@ -36,6 +36,7 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   float time_scale = 0.0f;
   bool reset = false, pause = false, resume = false;
   bool no_ack = false;
+  double read_rate_kb = 0.0;
 
   po::options_description flags("Options");
   flags.add_options()("help,h", "print this help and exit")("connect", po::value(&connect)->default_value(connect),
@@ -46,6 +47,8 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
       "observer", po::bool_switch(&o.script.observer), "ask for no player sphere")(
       "no-ack", po::bool_switch(&no_ack),
       "never acknowledge snapshots, so that the server sends each in full instead of a delta")(
+      "read-rate", po::value(&read_rate_kb)->default_value(0.0),
+      "kB a second each connection reads at most, as over a slow link (a phone on a busy Wi-Fi); 0: no limit")(
       "add", po::value(&add)->default_value(0), "balls the first client asks the server to pour in")(
       "move", po::value(&move), "player sphere velocity x,y,z in m/s (every client with a sphere)")(
       "for", po::value(&o.script.move_for)->default_value(o.script.move_for), "seconds to move before stopping")(
@@ -81,6 +84,7 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
     std::ostringstream help;
     help << "fishtank-client: connects to a fishtank-server, runs a short script and reports what it received.\n\n"
          << "Usage: fishtank-client [--connect host:port] [--clients K [--max-pending N]] [--observer] [--no-ack]\n"
+         << "                       [--read-rate KB]\n"
          << "                       [--add N] [--move x,y,z --for T] [--duration T] [--every T] [--json]\n"
          << "                       [--scene NAME | --reset] [--seed S] [--time-scale X] [--pause | --resume] [--step "
             "N]\n\n"
@@ -112,6 +116,8 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
     return fail("--duration must be more than 0 and at most 86400 seconds, got " + number_text(o.script.duration));
   if (!std::isfinite(o.script.every) || o.script.every < 0.0)
     return fail("--every must be seconds >= 0, got " + number_text(o.script.every));
+  if (!std::isfinite(read_rate_kb) || read_rate_kb < 0.0 || (read_rate_kb > 0.0 && read_rate_kb < 1.0))
+    return fail("--read-rate must be 0 (no limit) or at least 1 kB a second, got " + number_text(read_rate_kb));
   if (pause && resume) return fail("--pause and --resume contradict each other; give one");
   if (step < 0 || step > protocol::kMaxStepsPerRequest)
     return fail("--step must be between 0 and " + std::to_string(protocol::kMaxStepsPerRequest) + ", got " +
@@ -131,6 +137,7 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
   o.script.clients = static_cast<int>(clients);
   o.script.max_pending = static_cast<std::size_t>(max_pending);
   o.script.acknowledge = !no_ack;
+  o.script.read_rate = 1e3 * read_rate_kb;
   o.script.add = static_cast<std::uint32_t>(add);
   result.options = o;
   return result;

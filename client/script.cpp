@@ -25,6 +25,13 @@ constexpr auto kRampTick = std::chrono::milliseconds(1);
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+// The median of values (reordered); 0 when there are none.
+double median(std::vector<double>& values) {
+  if (values.empty()) return 0.0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
 Summary summarise(const std::vector<std::shared_ptr<Connection>>& connections, double seconds) {
   Summary s;
   s.clients = static_cast<int>(connections.size());
@@ -75,10 +82,7 @@ Summary summarise(const std::vector<std::shared_ptr<Connection>>& connections, d
     s.snapshot_rate_hz /= rated;
     s.bytes_per_s /= rated;
   }
-  if (!rtts.empty()) {
-    std::nth_element(rtts.begin(), rtts.begin() + rtts.size() / 2, rtts.end());
-    s.rtt_ms = rtts[rtts.size() / 2];
-  }
+  s.rtt_ms = median(rtts);
   return s;
 }
 
@@ -126,6 +130,7 @@ Summary run_script(const Script& script, const std::function<void(const Interval
     connections.push_back(
         std::make_shared<Connection>(io, "fishtank-client-" + std::to_string(i + 1), !script.observer));
     connections.back()->acknowledge_snapshots(script.acknowledge);
+    connections.back()->limit_read_rate(script.read_rate);
   }
   // Opened a few at a time (--max-pending): all at once, a server's --max-pending-per-address would evict most of
   // them as a stranger's stalled connections before their Hello is read.
@@ -154,17 +159,22 @@ Summary run_script(const Script& script, const std::function<void(const Interval
   asio::steady_timer timer(io);
   std::vector<double> dropped_at(connections.size(), -1.0);  // seconds; -1 while open
   IntervalReport reported;                                   // the totals at the last report
+  std::vector<std::size_t> pongs_reported(connections.size(), 0);
   const auto report_interval = [&](double t) {
     IntervalReport now;
     now.t = t;
-    for (const auto& c : connections) {
-      now.snapshots += c->stats().snapshots;
-      now.keyframes += c->stats().keyframes;
-      now.bytes += c->stats().bytes_received;
-      now.balls = std::max(now.balls, c->view().ball_count);
+    std::vector<double> rtts;
+    for (std::size_t i = 0; i < connections.size(); ++i) {
+      const ConnectionStats& st = connections[i]->stats();
+      now.snapshots += st.snapshots;
+      now.keyframes += st.keyframes;
+      now.bytes += st.bytes_received;
+      now.balls = std::max(now.balls, connections[i]->view().ball_count);
+      rtts.insert(rtts.end(), st.rtt_ms.begin() + pongs_reported[i], st.rtt_ms.end());
+      pongs_reported[i] = st.rtt_ms.size();
     }
     on_interval({now.t, now.balls, now.snapshots - reported.snapshots, now.keyframes - reported.keyframes,
-                 now.bytes - reported.bytes});
+                 now.bytes - reported.bytes, rtts.empty() ? std::nullopt : std::optional(median(rtts))});
     reported = now;
   };
   std::function<void()> on_tick = [&] {

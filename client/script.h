@@ -24,6 +24,7 @@ struct Script {
   std::size_t max_pending = kDefaultMaxPendingPerAddress;
   bool observer = false;
   bool acknowledge = true;  // false (--no-ack): every snapshot comes in full
+  double read_rate = 0.0;   // bytes a second each connection reads at most (--read-rate); 0: no limit
   std::uint32_t add = 0;
   std::optional<Vec3> move;
   double move_for = 1.0;  // seconds
@@ -43,6 +44,7 @@ struct IntervalReport {
   double t = 0.0;           // seconds since the start, at the end of the interval
   std::uint32_t balls = 0;  // in the newest snapshot
   std::uint64_t snapshots = 0, keyframes = 0, bytes = 0;
+  std::optional<double> rtt_ms;  // median of the Pongs that came back in the interval; empty: none did
 };
 
 struct Summary {
