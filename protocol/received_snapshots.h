@@ -2,8 +2,8 @@
 // A client's side of delta snapshots (protocol/snapshot_delta.h): it rebuilds
 // each Snapshot's positions, full or delta, and keeps the newest few as the
 // bases the server may code against (it codes against the newest one this
-// client acknowledged, and the one it sent before that, never older than
-// kKeptBases snapshots).
+// client acknowledged, and the one it sent before that, never older than the
+// kKeptBases snapshots it sent this client last).
 // Used by fishtank-viewer and fishtank-client alike.
 //
 //   Snapshot ─► positions(s, out) ─ok─► Ack(s.tick)            base kept
@@ -19,7 +19,7 @@
 
 namespace fishtank::protocol {
 
-// Snapshots the server keeps to code against, at most, and so every client keeps.
+// Snapshots sent to a client that the server may code against, at most, and so every client keeps.
 inline constexpr std::size_t kKeptBases = 32;
 
 class ReceivedSnapshots {

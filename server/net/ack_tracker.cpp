@@ -6,12 +6,19 @@
 
 namespace fishtank::net {
 
-void AckTracker::sent(std::uint32_t tick) {
+void AckTracker::sent(std::uint32_t tick, Clock::time_point now) {
   sent_.push_back(tick);
   if (sent_.size() > protocol::kKeptBases) sent_.pop_front();
+  out_.push_back({tick, now});
+  if (out_.size() > kMaxOut) out_.pop_front();
 }
 
-std::string AckTracker::acknowledged(std::uint32_t tick, bool want_keyframe) {
+std::string AckTracker::acknowledged(std::uint32_t tick, bool want_keyframe, Clock::time_point now) {
+  // The snapshot came back, and every one sent before it arrived too.
+  const auto later = std::find_if(out_.begin(), out_.end(), [&](const Out& o) { return o.tick > tick; });
+  if (later != out_.begin() && (later - 1)->tick == tick)
+    quickest_ = std::min(quickest_.value_or(now - (later - 1)->at), now - (later - 1)->at);
+  out_.erase(out_.begin(), later);
   if (want_keyframe) {
     base_.reset();
     return {};
@@ -32,11 +39,21 @@ std::string AckTracker::acknowledged(std::uint32_t tick, bool want_keyframe) {
   return {};
 }
 
+std::optional<std::uint32_t> AckTracker::base() const {
+  if (!base_ || sent_.empty() || *base_ < sent_.front()) return std::nullopt;
+  return base_;
+}
+
 std::optional<std::uint32_t> AckTracker::prior() const {
-  if (!base_) return std::nullopt;
+  if (!base()) return std::nullopt;
   const auto at = std::lower_bound(sent_.begin(), sent_.end(), *base_);
   if (at == sent_.begin() || at == sent_.end() || *at != *base_) return std::nullopt;
   return *(at - 1);
+}
+
+bool AckTracker::may_send(Clock::time_point now) const {
+  if (!quickest_ || out_.empty()) return true;  // a client that never acknowledges is not held
+  return now - out_.front().at <= *quickest_ + kQueueAllowance || now - out_.back().at >= kLongestHold;
 }
 
 }  // namespace fishtank::net

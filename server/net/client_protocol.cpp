@@ -137,7 +137,7 @@ Outcome ClientProtocol::on_message(const wire::Message& message, Clock::time_poi
       return out;
     case wire::Payload::Ack: {
       const wire::Ack& ack = *message.payload_as_Ack();
-      if (std::string why = acks_.acknowledged(ack.tick(), ack.want_keyframe()); !why.empty())
+      if (std::string why = acks_.acknowledged(ack.tick(), ack.want_keyframe(), now); !why.empty())
         return refuse(wire::ErrorCode::invalid_value, why, /*disconnect=*/false);
       return out;
     }

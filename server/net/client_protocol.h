@@ -87,7 +87,9 @@ class ClientProtocol {
   Outcome on_evicted(const std::string& why);
 
   // A Snapshot with this tick went out to the client.
-  void on_snapshot_sent(std::uint32_t tick) { acks_.sent(tick); }
+  void on_snapshot_sent(std::uint32_t tick, Clock::time_point now = Clock::now()) { acks_.sent(tick, now); }
+  // False while the client's link is queueing snapshots (AckTracker): the newest waits for its next Ack.
+  bool may_send_snapshot(Clock::time_point now = Clock::now()) const { return acks_.may_send(now); }
   // The snapshot the next one may be coded against; empty: send a keyframe.
   std::optional<std::uint32_t> delta_base() const { return acks_.base(); }
   // The snapshot sent before that one, to predict moving balls from; empty: none.

@@ -93,7 +93,8 @@ void Session::do_write() {
   writing_replies_.assign(std::make_move_iterator(replies_.begin()), std::make_move_iterator(replies_.end()));
   replies_.clear();
   for (const protocol::Frame& reply : writing_replies_) buffers.push_back(asio::buffer(reply));
-  if (newest_snapshot_ && !close_after_write_) {
+  // A snapshot held for a queueing link goes with the write after the client's next Ack (carry_out).
+  if (newest_snapshot_ && !close_after_write_ && protocol_.may_send_snapshot()) {
     const SharedSnapshot snapshot = std::move(newest_snapshot_);
     newest_snapshot_.reset();
     const std::uint32_t balls = snapshot->ball_count;

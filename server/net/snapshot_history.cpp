@@ -14,7 +14,7 @@ std::size_t bytes_of(const PublishedSnapshot& s) { return s.quantised.size() * s
 void SnapshotHistory::publish(SharedSnapshot snapshot) {
   kept_bytes_ += bytes_of(*snapshot);
   kept_.push_back(std::move(snapshot));
-  while (kept_.size() > 1 && (kept_.size() > protocol::kKeptBases || kept_bytes_ > kMaxBytes)) {
+  while (kept_.size() > 1 && (kept_.size() > kKeptPublished || kept_bytes_ > kMaxBytes)) {
     kept_bytes_ -= bytes_of(*kept_.front());
     kept_.pop_front();
   }

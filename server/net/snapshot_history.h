@@ -1,7 +1,7 @@
 #pragma once
 // The io thread's store of recent snapshots, and the frames of the newest one.
 //
-//   physics thread ─► publish(s) ─► [ newest kKeptBases snapshots ]   the bases
+//   physics thread ─► publish(s) ─► [ newest kKeptPublished snapshots ]   the bases
 //   session ─► frame(newest, base, prior) ─► cache hit? ─► the same frame for every client with that base
 //                                     └ miss: code a delta against base (or a keyframe: no base,
 //                                       or one no longer kept), keep it for the next client
@@ -18,6 +18,7 @@
 #include <optional>
 #include <vector>
 
+#include "protocol/received_snapshots.h"
 #include "server/net/snapshot_encoder.h"
 
 namespace fishtank::net {
@@ -38,6 +39,9 @@ struct FrameStats {
 
 class SnapshotHistory {
  public:
+  // Snapshots kept to code against: a client keeps its newest protocol::kKeptBases received, which
+  // span more than that many published where a slow link gets only some (AckTracker): about 2 s at 60 a second.
+  static constexpr std::size_t kKeptPublished = 4 * protocol::kKeptBases;
   // Bases kept at most, whatever their size, so that a huge tank keeps fewer
   // snapshots rather than gigabytes.
   static constexpr std::size_t kMaxBytes = std::size_t{256} << 20;

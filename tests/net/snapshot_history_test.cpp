@@ -32,12 +32,12 @@ struct SimulatedClient {
   std::optional<std::vector<std::uint16_t>> receive(int n, net::SnapshotHistory& history,
                                                     const net::SharedSnapshot& s) {
     while (!acks_in_flight.empty() && acks_in_flight.front().first <= n) {
-      REQUIRE(tracker.acknowledged(acks_in_flight.front().second, false).empty());
+      REQUIRE(tracker.acknowledged(acks_in_flight.front().second, false, {}).empty());
       acks_in_flight.pop_front();
     }
     if (n % every != 0) return std::nullopt;
     const net::CodedSnapshot coded = history.frame(s, acks ? tracker.base() : std::nullopt);
-    tracker.sent(s->header.tick);
+    tracker.sent(s->header.tick, {});
     const protocol::DecodeResult r =
         protocol::decode_frame(coded.frame->data(), coded.frame->size(), Direction::to_client);
     REQUIRE(r.ok());
@@ -125,15 +125,17 @@ TEST_CASE("clients that acknowledged the same snapshot share one frame, and an u
   CHECK(history.frame(newest, 5).keyframe);   // itself is no base
 
   SECTION("a base older than the history keeps is answered with a keyframe") {
-    for (std::uint32_t t = 6; t < 6 + protocol::kKeptBases; ++t) history.publish(snapshot_at(t));
-    const net::SharedSnapshot later = snapshot_at(100);
+    for (std::uint32_t t = 6; t < 6 + net::SnapshotHistory::kKeptPublished; ++t) history.publish(snapshot_at(t));
+    const net::SharedSnapshot later = snapshot_at(1000);
     history.publish(later);
     CHECK(history.frame(later, 4).keyframe);
-    CHECK_FALSE(history.frame(later, 6 + protocol::kKeptBases - 1).keyframe);
+    CHECK_FALSE(history.frame(later, 7).keyframe);  // more than 32 ago: a base of a client that got few of them
+    CHECK_FALSE(history.frame(later, 6 + net::SnapshotHistory::kKeptPublished - 1).keyframe);
   }
 }
 
-TEST_CASE("an Ack the client cannot have meant gets an Error, then a keyframe, and the connection stays", "[net][delta]") {
+TEST_CASE("an Ack the client cannot have meant gets an Error, then a keyframe, and the connection stays",
+          "[net][delta]") {
   net::ServerInfo info;
   info.variant = "sse";
   info.simd = "sse4.1";
@@ -176,10 +178,12 @@ TEST_CASE("an Ack the client cannot have meant gets an Error, then a keyframe, a
     CHECK(send(protocol::encode_ack(13, /*want_keyframe=*/true)).replies.empty());
     CHECK_FALSE(conversation.delta_base());
   }
-  SECTION("an ack older than any kept is harmless") {
+  SECTION("an ack older than any kept is harmless, and a base the client no longer keeps is none") {
     for (std::uint32_t t = 20; t < 20 + protocol::kKeptBases; ++t) conversation.on_snapshot_sent(t);
     CHECK(send(protocol::encode_ack(13)).replies.empty());
-    CHECK(conversation.delta_base() == 11u);
+    CHECK_FALSE(conversation.delta_base());  // 11 left the client's kept bases with the 32 sent since
+    CHECK(send(protocol::encode_ack(40)).replies.empty());
+    CHECK(conversation.delta_base() == 40u);
   }
 }
 
@@ -201,4 +205,43 @@ TEST_CASE("a delta that would be larger than the full snapshot is sent in full",
       protocol::decode_frame(coded.frame->data(), coded.frame->size(), Direction::to_client);
   REQUIRE(r.ok());
   CHECK(r.message->payload_as_Snapshot()->positions()->size() == 300);
+}
+
+TEST_CASE(
+    "snapshots to a client wait while its Acks lag its quickest round trip by more than the allowance, "
+    "a second at most",
+    "[net][delta]") {
+  using std::chrono::milliseconds;
+  const net::AckTracker::Clock::time_point t0{};
+  net::AckTracker tracker;
+  tracker.sent(1, t0);
+  tracker.sent(2, t0 + milliseconds(17));
+  CHECK(tracker.may_send(t0 + milliseconds(500)));  // nothing acknowledged yet: as for a client that never does
+  tracker.acknowledged(1, false, t0 + milliseconds(10));
+  CHECK(tracker.quickest_round_trip() == milliseconds(10));
+  // 2 is out: it may be out for 10 + 50 ms before the link counts as queueing.
+  CHECK(tracker.may_send(t0 + milliseconds(17 + 60)));
+  CHECK_FALSE(tracker.may_send(t0 + milliseconds(17 + 61)));
+  tracker.acknowledged(2, false, t0 + milliseconds(200));  // came back late: the quickest stays 10 ms
+  CHECK(tracker.quickest_round_trip() == milliseconds(10));
+  CHECK(tracker.may_send(t0 + milliseconds(200)));  // nothing out
+
+  // An Ack of a later snapshot answers the earlier ones too: TCP keeps their order.
+  tracker.sent(3, t0 + milliseconds(200));
+  tracker.sent(4, t0 + milliseconds(217));
+  CHECK_FALSE(tracker.may_send(t0 + milliseconds(300)));
+  tracker.acknowledged(4, false, t0 + milliseconds(305));
+  CHECK(tracker.may_send(t0 + milliseconds(305)));
+
+  // A client that stops acknowledging is sent a snapshot a second.
+  tracker.sent(5, t0 + milliseconds(305));
+  CHECK_FALSE(tracker.may_send(t0 + milliseconds(1304)));
+  CHECK(tracker.may_send(t0 + milliseconds(1305)));
+  tracker.sent(6, t0 + milliseconds(1305));
+  CHECK_FALSE(tracker.may_send(t0 + milliseconds(1400)));
+
+  // A keyframe asked for is an answer as well.
+  tracker.acknowledged(6, true, t0 + milliseconds(1400));
+  CHECK(tracker.may_send(t0 + milliseconds(1400)));
+  CHECK_FALSE(tracker.base());
 }

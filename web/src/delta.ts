@@ -8,7 +8,7 @@
 
 import type { Snapshot } from 'fishtank-wire';
 
-// Snapshots the server may code against, at most (kKeptBases in received_snapshots.h).
+// Snapshots sent to this page that the server may code against, at most (kKeptBases in received_snapshots.h).
 const KEPT_BASES = 32;
 // Below this a move from prior to base is jitter, not velocity (kMovingQuanta).
 const MOVING_QUANTA = 4;
