@@ -57,6 +57,7 @@ class NetServer final : public SessionOwner {
   const std::atomic<int>& viewers() const { return viewers_; }
   int clients() const { return clients_.load(std::memory_order_relaxed); }
   std::uint64_t total_bytes_sent() const { return bytes_sent_.load(std::memory_order_relaxed); }
+  std::uint64_t total_snapshots_skipped() const { return snapshots_skipped_.load(std::memory_order_relaxed); }
 
   // SessionOwner (io thread)
   bool submit(Command command) override;
@@ -64,6 +65,7 @@ class NetServer final : public SessionOwner {
   void session_welcomed(Session& session) override;
   void session_closed(Session& session) override;
   void bytes_sent(std::size_t bytes) override;
+  void snapshot_skipped() override { snapshots_skipped_.fetch_add(1, std::memory_order_relaxed); }
   CodedSnapshot snapshot_frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base,
                                std::optional<std::uint32_t> prior) override {
     return history_.frame(snapshot, base, prior);
@@ -115,6 +117,7 @@ class NetServer final : public SessionOwner {
   std::atomic<int> viewers_{0};
   std::atomic<int> clients_{0};
   std::atomic<std::uint64_t> bytes_sent_{0};
+  std::atomic<std::uint64_t> snapshots_skipped_{0};
 };
 
 }  // namespace fishtank::net

@@ -6,6 +6,7 @@
 #include <boost/asio/ip/host_name.hpp>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 
 #include "server/net/machine_addresses.h"
 
@@ -89,6 +90,7 @@ std::string NetworkService::status() {
   const auto now = std::chrono::steady_clock::now();
   const double window = std::chrono::duration<double>(now - last_status_).count();
   const std::uint64_t bytes = server_.total_bytes_sent();
+  const std::uint64_t skipped = server_.total_snapshots_skipped();
   const double io_cpu = io_thread_.joinable() ? thread_cpu_seconds(io_thread_) : 0.0;
   const double process_cpu = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID);
   const SnapshotStats& snapshots = link_.snapshot_stats();
@@ -108,7 +110,7 @@ std::string NetworkService::status() {
       encoded ? 1e6 * ((snapshots.encode_seconds - last_encode_seconds_) + (coding_seconds - last_coding_seconds_)) /
                     encoded
               : 0.0;
-  char line[320];
+  char line[400];
   std::snprintf(line, sizeof line,
                 "clients %d  out %.2f MB/s  net cpu %.1f %% of process  snapshot %.0f us to encode, %.2f frames of "
                 "%.0f B mean, %llu keyframes",
@@ -117,9 +119,14 @@ std::string NetworkService::status() {
                 encoded ? static_cast<double>(coded) / encoded : 0.0,
                 coded ? static_cast<double>(frame_bytes - last_frame_bytes_) / coded : 0.0,
                 static_cast<unsigned long long>(keyframes - last_keyframes_));
+  // Only while some client cannot take every snapshot: a slow link, or a reader busier than the server.
+  if (skipped > last_skipped_ && window > 0.0)
+    std::snprintf(line + std::strlen(line), sizeof line - std::strlen(line),
+                  ", %.0f snapshots/s skipped for slow clients", (skipped - last_skipped_) / window);
 
   last_status_ = now;
   last_bytes_ = bytes;
+  last_skipped_ = skipped;
   last_io_cpu_ = io_cpu;
   last_process_cpu_ = process_cpu;
   last_encode_seconds_ = snapshots.encode_seconds;

@@ -61,6 +61,7 @@ void Session::carry_out(Outcome outcome) {
 
 void Session::offer_snapshot(SharedSnapshot snapshot) {
   if (closed_ || close_after_write_ || !protocol_.welcomed() || !protocol_.watching()) return;
+  if (newest_snapshot_) owner_.snapshot_skipped();
   newest_snapshot_ = std::move(snapshot);  // an unsent older one is dropped here
   do_write();
 }

@@ -47,6 +47,8 @@ class SessionOwner {
   virtual void session_welcomed(Session& session) = 0;
   virtual void session_closed(Session& session) = 0;
   virtual void bytes_sent(std::size_t bytes) = 0;
+  // A snapshot offered to a session was replaced by a newer one before it could go out: a slow link or reader.
+  virtual void snapshot_skipped() = 0;
   // The frame of snapshot for a client that holds snapshots `base` (empty: none) and `prior`.
   virtual CodedSnapshot snapshot_frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base,
                                        std::optional<std::uint32_t> prior) = 0;

@@ -540,6 +540,7 @@ TEST_CASE("a client on a slow link gets fewer snapshots, not older ones: its pic
   CHECK(late.back() < 2000.0);
   CHECK(slow->stats().snapshots >= 16);  // still a picture or more a second
   CHECK(slow->stats().errors.empty());
+  CHECK_THAT(server.log(), Catch::Contains("snapshots/s skipped for slow clients"));  // the status line says so
 }
 
 TEST_CASE("players who join together start apart, not as one sphere", "[net]") {
