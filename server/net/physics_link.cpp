@@ -147,8 +147,9 @@ void PhysicsLink::refresh_figures(const World& world, Clock::time_point now) {
   next_figures_ = now + kFiguresPeriod;
   figures_start_ = scene_.start_count();
   kinetic_energy_per_ball_ = world.ball_count() ? static_cast<float>(kinetic_energy(world) / world.ball_count()) : 0.0f;
-  contacts_ = contact_count(world);
-  max_overlap_ = max_overlap_fraction(world);
+  const ContactFigures contact = contact_figures(world);
+  contacts_ = contact.contacts;
+  max_overlap_ = contact.max_overlap;
 }
 
 void PhysicsLink::publish_snapshot(const World& world, const LoopStatus& status) {

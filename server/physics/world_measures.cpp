@@ -77,52 +77,39 @@ std::string overlap_warning(const World& world) {
   return text;
 }
 
-std::uint32_t contact_count(const World& world) {
-  if (!world.lists_current()) return 0;  // no lists yet: nothing has been stepped
-  const TankBounds& t = world.params().tank;
-  const Float4* pos = world.positions();
-  std::uint32_t sides = 0;  // each pair is listed from both sides
-  world.neighbour_list().for_each_list([&](std::uint32_t i, ListView list) {
-    const Float4& p = pos[i];
-    for (std::uint32_t n = 0; n < list.count; ++n) {
-      const Float4& q = pos[list[n]];
-      float dx = p.x - q.x, dy = p.y - q.y, dz = p.z - q.z, reach = p.w + q.w;
-      sides += dx * dx + dy * dy + dz * dz < reach * reach;
-    }
-  });
-  std::uint32_t walls = 0;
-  for (std::uint32_t i = 0; i < world.ball_count(); ++i) {
-    const Float4& p = pos[i];
-    walls += (p.x - p.w < t.min.x) + (p.x + p.w > t.max.x) + (p.y - p.w < t.min.y) + (p.y + p.w > t.max.y) +
-             (p.z - p.w < t.min.z) + (p.z + p.w > t.max.z);
-  }
-  return sides / 2 + walls;
-}
-
-float max_overlap_fraction(const World& world) {
-  float worst = 0.0f;
+ContactFigures contact_figures(const World& world) {
+  ContactFigures figures;
   const TankBounds& t = world.params().tank;
   const Float4* pos = world.positions();
   // The neighbour list holds every touching pair (stale only between a spawn and the next step).
   if (world.lists_current()) {
+    std::uint32_t sides = 0;  // each pair is listed from both sides
     world.neighbour_list().for_each_list([&](std::uint32_t i, ListView list) {
       const Float4& p = pos[i];
       for (std::uint32_t n = 0; n < list.count; ++n) {
         const Float4& q = pos[list[n]];
-        float dx = p.x - q.x, dy = p.y - q.y, dz = p.z - q.z;
-        float overlap = p.w + q.w - std::sqrt(dx * dx + dy * dy + dz * dz);
-        worst = std::max(worst, overlap / std::min(p.w, q.w));
+        const float dx = p.x - q.x, dy = p.y - q.y, dz = p.z - q.z, reach = p.w + q.w;
+        const float d2 = dx * dx + dy * dy + dz * dz;
+        if (d2 >= reach * reach) continue;  // a gap: no contact, no overlap
+        ++sides;
+        figures.max_overlap = std::max(figures.max_overlap, (reach - std::sqrt(d2)) / std::min(p.w, q.w));
       }
     });
+    figures.contacts = sides / 2;
   }
   for (std::uint32_t i = 0; i < world.ball_count(); ++i) {
     const Float4& p = pos[i];
-    float walls = std::max({t.min.x + p.w - p.x, p.x + p.w - t.max.x, t.min.y + p.w - p.y, p.y + p.w - t.max.y,
-                            t.min.z + p.w - p.z, p.z + p.w - t.max.z});
-    worst = std::max(worst, walls / p.w);
+    const float walls[6] = {t.min.x + p.w - p.x, p.x + p.w - t.max.x, t.min.y + p.w - p.y,
+                            p.y + p.w - t.max.y, t.min.z + p.w - p.z, p.z + p.w - t.max.z};
+    for (const float overlap : walls) {
+      figures.contacts += world.lists_current() && overlap > 0.0f;
+      figures.max_overlap = std::max(figures.max_overlap, overlap / p.w);
+    }
   }
-  return worst;
+  return figures;
 }
+
+float max_overlap_fraction(const World& world) { return contact_figures(world).max_overlap; }
 
 float pile_top(const World& world) {
   const Float4* pos = world.positions();

@@ -17,10 +17,13 @@ double kinetic_energy(const World& world);
 float max_speed(const World& world);          // the fastest ball's, m/s
 double potential_energy(const World& world);  // gravity, relative to y = 0
 double elastic_energy(const World& world);    // springs of every contact: sum of k x^2 / 2
-// Overlapping ball pairs and ball-wall contacts (0 before the first step).
-std::uint32_t contact_count(const World& world);
-// Largest overlap (ball-ball, ball-wall), as a fraction of the smaller radius.
-float max_overlap_fraction(const World& world);
+struct ContactFigures {
+  std::uint32_t contacts = 0;  // overlapping ball pairs and ball-wall contacts (0 before the first step)
+  float max_overlap = 0.0f;    // largest overlap (ball-ball, ball-wall), a fraction of the smaller radius
+};
+// Both in one pass over the lists.
+ContactFigures contact_figures(const World& world);
+float max_overlap_fraction(const World& world);  // contact_figures().max_overlap
 // Whether max_overlap_fraction() is past kOverlapWarning while the balls are
 // near rest, and a sentence that says so (empty otherwise): a softer k than
 // the scene's load allows. An impact's overlap (v sqrt(m / k): 35 % at 28 m/s)

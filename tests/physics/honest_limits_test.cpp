@@ -51,3 +51,17 @@ TEST_CASE("an impact's deep overlap is reported but gives no warning", "[physics
   }
   CHECK(deepest > 0.25f);
 }
+TEST_CASE("the HUD's contacts count each touching pair once and each wall contact, its overlap the deepest",
+          "[physics][limits]") {
+  World world(open_space(), kScalarKernels, 1, 1);
+  const float r = kBallKinds[0].diameter / 2;
+  world.place_ball(0, {0.0f, 50.0f, 0.0f}, {});
+  world.place_ball(0, {2 * r - 0.2f * r, 50.0f, 0.0f}, {});       // overlaps the first by 20 % of r
+  world.place_ball(0, {4 * r - 0.1f * r, 50.0f, 0.0f}, {});       // a gap of 0.1 r: listed, not touching
+  world.place_ball(0, {-50.0f + r - 0.1f * r, 50.0f, 0.0f}, {});  // 10 % into the wall at x = -50
+  world.step();                                                   // the lists are built
+  const ContactFigures figures = contact_figures(world);
+  CHECK(figures.contacts == 2);
+  CHECK(figures.max_overlap == Approx(0.2f).epsilon(0.05));  // the first step pushes them 3 % apart
+  CHECK(max_overlap_fraction(world) == figures.max_overlap);
+}
