@@ -16,8 +16,13 @@ void AckTracker::sent(std::uint32_t tick, Clock::time_point now) {
 std::string AckTracker::acknowledged(std::uint32_t tick, bool want_keyframe, Clock::time_point now) {
   // The snapshot came back, and every one sent before it arrived too.
   const auto later = std::find_if(out_.begin(), out_.end(), [&](const Out& o) { return o.tick > tick; });
-  if (later != out_.begin() && (later - 1)->tick == tick)
-    quickest_ = std::min(quickest_.value_or(now - (later - 1)->at), now - (later - 1)->at);
+  if (later != out_.begin() && (later - 1)->tick == tick) {
+    const Clock::duration took = now - (later - 1)->at;
+    // Slower ones before it can never be the quickest again; older ones have left the window.
+    while (!round_trips_.empty() && round_trips_.back().took >= took) round_trips_.pop_back();
+    while (!round_trips_.empty() && round_trips_.front().at < now - kRoundTripWindow) round_trips_.pop_front();
+    round_trips_.push_back({now, took});
+  }
   out_.erase(out_.begin(), later);
   if (want_keyframe) {
     base_.reset();
@@ -51,9 +56,14 @@ std::optional<std::uint32_t> AckTracker::prior() const {
   return *(at - 1);
 }
 
+std::optional<AckTracker::Clock::duration> AckTracker::quickest_round_trip() const {
+  if (round_trips_.empty()) return std::nullopt;
+  return round_trips_.front().took;
+}
+
 bool AckTracker::may_send(Clock::time_point now) const {
-  if (!quickest_ || out_.empty()) return true;  // a client that never acknowledges is not held
-  return now - out_.front().at <= *quickest_ + kQueueAllowance || now - out_.back().at >= kLongestHold;
+  if (round_trips_.empty() || out_.empty()) return true;  // a client that never acknowledges is not held
+  return now - out_.front().at <= round_trips_.front().took + kQueueAllowance || now - out_.back().at >= kLongestHold;
 }
 
 }  // namespace fishtank::net

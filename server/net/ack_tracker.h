@@ -10,7 +10,7 @@
 // falls seconds behind, its base leaves the kept ones and keyframes make it
 // worse. A client that acknowledges shows how long its snapshots take to come
 // back; while the oldest not yet acknowledged is out longer than the quickest
-// round trip plus kQueueAllowance, the link is queueing and the newest snapshot
+// round trip of the last kRoundTripWindow plus kQueueAllowance, the link is queueing and the newest snapshot
 // waits for the next Ack instead, though never longer than kLongestHold (a
 // client that acknowledged only some snapshots would otherwise wait for ever).
 // A client that never acknowledges takes every snapshot in full as its
@@ -28,6 +28,8 @@ namespace fishtank::net {
 inline constexpr std::chrono::milliseconds kQueueAllowance{50};
 // ... and the longest a snapshot waits since the last went out.
 inline constexpr std::chrono::seconds kLongestHold{1};
+// The quickest round trip is of this span: a path that got slower (a phone roaming) is learnt within it.
+inline constexpr std::chrono::seconds kRoundTripWindow{10};
 // Snapshots out and not yet acknowledged whose times are kept: 4 s at 60 a second.
 inline constexpr std::size_t kMaxOut = 256;
 
@@ -45,19 +47,23 @@ class AckTracker {
   std::optional<std::uint32_t> prior() const;
   // False while the link is queueing: the next snapshot waits for an Ack.
   bool may_send(Clock::time_point now) const;
-  // The quickest round trip of a snapshot and its Ack so far; empty before the first.
-  std::optional<Clock::duration> quickest_round_trip() const { return quickest_; }
+  // The quickest round trip of a snapshot and its Ack over kRoundTripWindow up to the newest; empty before the first.
+  std::optional<Clock::duration> quickest_round_trip() const;
 
  private:
   struct Out {
     std::uint32_t tick;
     Clock::time_point at;
   };
+  struct RoundTrip {
+    Clock::time_point at;  // when the Ack came
+    Clock::duration took;
+  };
 
   std::deque<std::uint32_t> sent_;  // the newest kKeptBases ticks sent, oldest first
   std::optional<std::uint32_t> base_;
   std::deque<Out> out_;  // sent and not acknowledged (any Ack of a later one counts: TCP keeps order), oldest first
-  std::optional<Clock::duration> quickest_;
+  std::deque<RoundTrip> round_trips_;  // of the window: each quicker than every later one, so the first is quickest
 };
 
 }  // namespace fishtank::net

@@ -244,4 +244,12 @@ TEST_CASE(
   tracker.acknowledged(6, true, t0 + milliseconds(1400));
   CHECK(tracker.may_send(t0 + milliseconds(1400)));
   CHECK_FALSE(tracker.base());
+
+  // The quickest is of the last 10 s: a path that got slower is learnt.
+  for (std::uint32_t tick = 7; tick < 20; ++tick) {
+    const auto sent = t0 + std::chrono::seconds(tick);
+    tracker.sent(tick, sent);
+    tracker.acknowledged(tick, false, sent + milliseconds(100));
+  }
+  CHECK(tracker.quickest_round_trip() == milliseconds(100));
 }
