@@ -61,6 +61,11 @@ std::optional<AckTracker::Clock::duration> AckTracker::quickest_round_trip() con
   return round_trips_.front().took;
 }
 
+std::optional<AckTracker::Clock::time_point> AckTracker::oldest_unanswered() const {
+  if (round_trips_.empty() || out_.empty()) return std::nullopt;
+  return out_.front().at;
+}
+
 bool AckTracker::may_send(Clock::time_point now) const {
   if (round_trips_.empty() || out_.empty()) return true;  // a client that never acknowledges is not held
   return now - out_.front().at <= round_trips_.front().took + kQueueAllowance || now - out_.back().at >= kLongestHold;

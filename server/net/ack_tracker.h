@@ -47,6 +47,10 @@ class AckTracker {
   std::optional<std::uint32_t> prior() const;
   // False while the link is queueing: the next snapshot waits for an Ack.
   bool may_send(Clock::time_point now) const;
+  // When the oldest snapshot not yet answered went out, for a client that acknowledges; empty when none is out.
+  std::optional<Clock::time_point> oldest_unanswered() const;
+  // The client asked for no more snapshots (Watching off): those out need no answer.
+  void forget_unanswered() { out_.clear(); }
   // The quickest round trip of a snapshot and its Ack over kRoundTripWindow up to the newest; empty before the first.
   std::optional<Clock::duration> quickest_round_trip() const;
 

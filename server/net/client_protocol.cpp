@@ -134,6 +134,7 @@ Outcome ClientProtocol::on_message(const wire::Message& message, Clock::time_poi
       return on_control(message);
     case wire::Payload::Watching:
       watching_ = message.payload_as_Watching()->on();
+      if (!watching_) acks_.forget_unanswered();
       return out;
     case wire::Payload::Ack: {
       const wire::Ack& ack = *message.payload_as_Ack();
@@ -230,6 +231,16 @@ Outcome ClientProtocol::on_write_stalled(bool sent_meanwhile) {
                   /*disconnect=*/true);
   return refuse(wire::ErrorCode::idle_timeout,
                 "the client neither sent nor read anything for " + idle + " (--idle-timeout)",
+                /*disconnect=*/true);
+}
+
+Outcome ClientProtocol::on_acks_stopped(bool sent_meanwhile) {
+  const std::string idle = seconds_text(info_.limits.idle_timeout_s);
+  if (sent_meanwhile)
+    return refuse(wire::ErrorCode::too_slow, "the client answered no snapshot for " + idle + " (--idle-timeout)",
+                  /*disconnect=*/true);
+  return refuse(wire::ErrorCode::idle_timeout,
+                "the client neither answered a snapshot nor sent anything for " + idle + " (--idle-timeout)",
                 /*disconnect=*/true);
 }
 

@@ -83,6 +83,8 @@ class ClientProtocol {
   Outcome on_hello_timeout();
   Outcome on_write_stalled(bool sent_meanwhile);
   Outcome on_replies_piling_up(std::size_t unsent);
+  // A client that acknowledges answered no snapshot for --idle-timeout (sent_meanwhile: it sent other bytes).
+  Outcome on_acks_stopped(bool sent_meanwhile);
   // The server needs this connection's place for a newcomer (it has not said Hello).
   Outcome on_evicted(const std::string& why);
 
@@ -90,6 +92,8 @@ class ClientProtocol {
   void on_snapshot_sent(std::uint32_t tick, Clock::time_point now = Clock::now()) { acks_.sent(tick, now); }
   // False while the client's link is queueing snapshots (AckTracker): the newest waits for its next Ack.
   bool may_send_snapshot(Clock::time_point now = Clock::now()) const { return acks_.may_send(now); }
+  // When the oldest snapshot the client has not answered went out; empty when none is, or it never answers.
+  std::optional<Clock::time_point> oldest_unanswered_snapshot() const { return acks_.oldest_unanswered(); }
   // The snapshot the next one may be coded against; empty: send a keyframe.
   std::optional<std::uint32_t> delta_base() const { return acks_.base(); }
   // The snapshot sent before that one, to predict moving balls from; empty: none.

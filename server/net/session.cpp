@@ -154,6 +154,8 @@ Session::Clock::time_point Session::next_check(Clock::time_point now) const {
   if (hard_close_at_) return *hard_close_at_;
   Clock::time_point next = (write_in_flight_ ? write_started_ : now) + limit_duration(limits_.idle_timeout_s);
   if (!protocol_.hello_received()) next = std::min(next, connected_at_ + limit_duration(limits_.hello_timeout_s));
+  if (const auto unanswered = protocol_.oldest_unanswered_snapshot())
+    next = std::min(next, *unanswered + limit_duration(limits_.idle_timeout_s));
   if (const auto idle_player = protocol_.player_idle_deadline()) next = std::min(next, *idle_player);
   return next;
 }
@@ -169,6 +171,10 @@ void Session::check_limits() {
     return carry_out(protocol_.on_hello_timeout());
   if (write_in_flight_ && now >= write_started_ + limit_duration(limits_.idle_timeout_s))
     return carry_out(protocol_.on_write_stalled(/*sent_meanwhile=*/last_received_ > write_started_));
+  // Snapshots wait for an acknowledging client's Acks (AckTracker), so one that stopped answering stalls no write.
+  if (const auto unanswered = protocol_.oldest_unanswered_snapshot();
+      unanswered && now >= *unanswered + limit_duration(limits_.idle_timeout_s))
+    return carry_out(protocol_.on_acks_stopped(/*sent_meanwhile=*/last_received_ > *unanswered));
   if (const auto idle_player = protocol_.player_idle_deadline(); idle_player && now >= *idle_player)
     carry_out(protocol_.on_player_idle());
 }

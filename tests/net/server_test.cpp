@@ -543,6 +543,18 @@ TEST_CASE("a client on a slow link gets fewer snapshots, not older ones: its pic
   CHECK_THAT(server.log(), Catch::Contains("snapshots/s skipped for slow clients"));  // the status line says so
 }
 
+TEST_CASE("a client that stops answering its snapshots is closed after --idle-timeout and told why", "[net]") {
+  // Its snapshots wait for its Acks, so no write stalls: the watchdog counts from the oldest unanswered one.
+  ServerProcess server({"--balls", "300", "--idle-timeout", "1"});
+  Clients clients(server.port());
+  auto silent = clients.add(false);
+  REQUIRE(clients.wait_until([&] { return silent->stats().snapshots > 10; }, std::chrono::seconds(5)));
+  silent->acknowledge_snapshots(false);  // it still reads everything, and sends nothing more
+  REQUIRE(clients.wait_until([&] { return silent->closed(); }, std::chrono::seconds(8)));
+  CHECK(has_error(*silent, "idle_timeout"));
+  CHECK(server.running());
+}
+
 TEST_CASE("players who join together start apart, not as one sphere", "[net]") {
   ServerProcess server({"--balls", "0"});
   Clients clients(server.port());

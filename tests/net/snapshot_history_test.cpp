@@ -240,13 +240,20 @@ TEST_CASE(
   tracker.sent(6, t0 + milliseconds(1305));
   CHECK_FALSE(tracker.may_send(t0 + milliseconds(1400)));
 
+  CHECK(tracker.oldest_unanswered() == t0 + milliseconds(305));  // what the idle watchdog counts from
   // A keyframe asked for is an answer as well.
   tracker.acknowledged(6, true, t0 + milliseconds(1400));
   CHECK(tracker.may_send(t0 + milliseconds(1400)));
   CHECK_FALSE(tracker.base());
+  CHECK_FALSE(tracker.oldest_unanswered());
+  // Watching off: what is out needs no answer.
+  tracker.sent(7, t0 + milliseconds(1500));
+  tracker.forget_unanswered();
+  CHECK_FALSE(tracker.oldest_unanswered());
+  CHECK(tracker.may_send(t0 + milliseconds(1600)));
 
   // The quickest is of the last 10 s: a path that got slower is learnt.
-  for (std::uint32_t tick = 7; tick < 20; ++tick) {
+  for (std::uint32_t tick = 8; tick < 20; ++tick) {
     const auto sent = t0 + std::chrono::seconds(tick);
     tracker.sent(tick, sent);
     tracker.acknowledged(tick, false, sent + milliseconds(100));
