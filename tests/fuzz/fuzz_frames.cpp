@@ -27,9 +27,19 @@ using namespace fishtank;
 
 namespace {
 
-// Everyone may use the controls, so the fuzzer reaches them.
-const net::ServerInfo kInfo{
-    "sse", "sse4.1", 2, TankBounds{}, 0.001f, 60.0f, ControlPolicy::everyone, net::ClientLimits{}};
+// Everyone may use the controls, so the fuzzer reaches them. Named fields: a field added to ServerInfo
+// cannot shift the others.
+net::ServerInfo fuzzed_server() {
+  net::ServerInfo info;
+  info.variant = "sse";
+  info.simd = "sse4.1";
+  info.worker_threads = 2;
+  info.dt = 0.001f;
+  info.snapshot_rate_hz = 60.0f;
+  info.control = ControlPolicy::everyone;
+  return info;
+}
+const net::ServerInfo kInfo = fuzzed_server();
 
 void check(bool ok) {
   if (!ok) std::abort();
