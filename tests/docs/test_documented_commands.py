@@ -52,6 +52,7 @@ EXCLUDED = {
     "scripts/figures-perf": "about 12 minutes; rewrites docs/figures/",
     "scripts/figures-web": "a minute of headless Chromium; rewrites docs/figures/",
     "scripts/figures-web-observers": "a minute and a half of WebSocket observers; rewrites docs/figures/",
+    "scripts/figures-slow-link": "40 s of a pour watched through throttled observers; rewrites docs/figures/",
     "scripts/abuse-table": "rebuilds the network tests and rewrites docs/figures/abuse.csv",
     "scripts/lammps-crosscheck": "times full scenes in fishtank-server and LAMMPS, minutes",
     "scripts/fuzz 60": "installs clang, builds a fuzzer and fuzzes for 60 s",
