@@ -10,11 +10,11 @@
 // falls seconds behind, its base leaves the kept ones and keyframes make it
 // worse. A client that acknowledges shows how long its snapshots take to come
 // back; while the oldest not yet acknowledged is out longer than the quickest
-// round trip of the last kRoundTripWindow plus kQueueAllowance, the link is queueing and the newest snapshot
-// waits for the next Ack instead, though never longer than kLongestHold (a
-// client that acknowledged only some snapshots would otherwise wait for ever).
-// A client that never acknowledges takes every snapshot in full as its
-// connection allows.
+// round trip of the last kRoundTripWindow plus kQueueAllowance, the link is
+// queueing and the newest snapshot waits for the next Ack instead, though never
+// longer than kLongestHold (a client that acknowledged only some snapshots
+// would otherwise wait for ever). A client that never acknowledges takes every
+// snapshot in full as its connection allows.
 
 #include <chrono>
 #include <cstdint>
