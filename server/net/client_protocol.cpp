@@ -225,23 +225,17 @@ Outcome ClientProtocol::on_hello_timeout() {
 }
 
 Outcome ClientProtocol::on_write_stalled(bool sent_meanwhile) {
-  const std::string idle = seconds_text(info_.limits.idle_timeout_s);
-  if (sent_meanwhile)
-    return refuse(wire::ErrorCode::too_slow, "the client read nothing for " + idle + " (--idle-timeout)",
-                  /*disconnect=*/true);
-  return refuse(wire::ErrorCode::idle_timeout,
-                "the client neither sent nor read anything for " + idle + " (--idle-timeout)",
-                /*disconnect=*/true);
+  return idle_refusal(sent_meanwhile, "read nothing", "sent nor read anything");
 }
 
 Outcome ClientProtocol::on_acks_stopped(bool sent_meanwhile) {
-  const std::string idle = seconds_text(info_.limits.idle_timeout_s);
-  if (sent_meanwhile)
-    return refuse(wire::ErrorCode::too_slow, "the client answered no snapshot for " + idle + " (--idle-timeout)",
-                  /*disconnect=*/true);
-  return refuse(wire::ErrorCode::idle_timeout,
-                "the client neither answered a snapshot nor sent anything for " + idle + " (--idle-timeout)",
-                /*disconnect=*/true);
+  return idle_refusal(sent_meanwhile, "answered no snapshot", "answered a snapshot nor sent anything");
+}
+
+Outcome ClientProtocol::idle_refusal(bool sent_meanwhile, const std::string& did, const std::string& neither) {
+  const std::string idle = " for " + seconds_text(info_.limits.idle_timeout_s) + " (--idle-timeout)";
+  if (sent_meanwhile) return refuse(wire::ErrorCode::too_slow, "the client " + did + idle, /*disconnect=*/true);
+  return refuse(wire::ErrorCode::idle_timeout, "the client neither " + neither + idle, /*disconnect=*/true);
 }
 
 Outcome ClientProtocol::on_replies_piling_up(std::size_t unsent) {

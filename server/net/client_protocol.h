@@ -116,6 +116,9 @@ class ClientProtocol {
   Outcome on_message(const wire::Message& message, Clock::time_point now);
   Outcome on_add_balls(std::uint32_t count, Clock::time_point now);
   Outcome refuse(wire::ErrorCode code, const std::string& why, bool disconnect);
+  // --idle-timeout passed: too_slow ("the client <did> for ...") where it sent meanwhile, else idle_timeout
+  // ("the client neither <neither> for ...").
+  Outcome idle_refusal(bool sent_meanwhile, const std::string& did, const std::string& neither);
   // Pause, Step, Reset, SetTimeScale: allowed by the policy, values the server knows.
   Outcome on_control(const wire::Message& message);
 

@@ -97,12 +97,13 @@ ContactFigures contact_figures(const World& world) {
     });
     figures.contacts = sides / 2;
   }
+  const bool counting = world.lists_current();  // the contacts count from the first step on
   for (std::uint32_t i = 0; i < world.ball_count(); ++i) {
     const Float4& p = pos[i];
     const float walls[6] = {t.min.x + p.w - p.x, p.x + p.w - t.max.x, t.min.y + p.w - p.y,
                             p.y + p.w - t.max.y, t.min.z + p.w - p.z, p.z + p.w - t.max.z};
     for (const float overlap : walls) {
-      figures.contacts += world.lists_current() && overlap > 0.0f;
+      figures.contacts += counting && overlap > 0.0f;
       figures.max_overlap = std::max(figures.max_overlap, overlap / p.w);
     }
   }
