@@ -259,7 +259,11 @@ TANK = ["--scene", "tank", "--balls", "6000", "--steps", "4000"]
 
 def bench(build, variant, *args):
     """--bench's JSON report of one run, with the 1-minute load average before and after it."""
-    cmd = variant.bench_command(build, *args)
+    return bench_command(variant.bench_command(build, *args))
+
+
+def bench_command(cmd):
+    """The JSON report of one --bench command line, with the 1-minute load average before and after it."""
     before = os.getloadavg()[0]
     done = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     if done.returncode != 0:

@@ -31,16 +31,18 @@ void TunedStepper::step() {
     world_.step();
     return;
   }
-  const Clock::time_point start = Clock::now();
+  // The tuner times the step pass alone: a step that rebuilds the lists costs a score of passes, and
+  // would make whichever count it fell on look dearer until the estimate forgot it.
+  const double pass_before = world_.phase_seconds().step_pass;
   world_.step();
-  const Clock::time_point end = Clock::now();
-  const double now = seconds_between(epoch_, end);
+  const double pass = world_.phase_seconds().step_pass - pass_before;
+  const double now = seconds_between(epoch_, Clock::now());
   machine_load_.update(now);  // after the step's clock: a reading is not a step's cost
   using Load = ThreadTuner::Load;
   const Load load = !machine_load_.room_for(world_.threads()) ? Load::kOneThread
                     : machine_load_.shared_per_thread()       ? Load::kEveryThread
                                                               : Load::kMeasure;
-  world_.set_thread_limit(tuner_->record(seconds_between(start, end), 1, now, load));
+  world_.set_thread_limit(tuner_->record(pass, 1, now, load));
 }
 
 void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::atomic<bool>& stop) {

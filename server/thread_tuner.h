@@ -7,7 +7,7 @@
 // each, every thread while work in the server's own session shares the cores
 // per thread. Step timings there are too noisy to choose by: they follow where
 // the kernel places the threads. Otherwise the tuner keeps a running cost
-// estimate of a step on every thread and on one (time constant kTimeConstant),
+// estimate of a step pass (list rebuilds left out) on every thread and on one (time constant kTimeConstant),
 // steps with the cheaper, and now and then times a few steps with the other (a probe).
 // Results never depend on the thread count: switching shows only in speed.
 
@@ -34,7 +34,7 @@ class ThreadTuner {
   // What the machine's load says (MachineLoad): nothing, or the count to step with, unprobed.
   enum class Load { kMeasure, kOneThread, kEveryThread };
 
-  // Records steps done: wall seconds spent stepping, steps, and the wall clock
+  // Records steps done: wall seconds their step passes took, steps, and the wall clock
   // (seconds) at their end. Returns the thread count for the next steps. When
   // the load stops deciding, the other count is probed at once.
   int record(double busy_seconds, std::uint64_t steps, double now, Load load = Load::kMeasure);
