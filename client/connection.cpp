@@ -18,7 +18,7 @@ void Connection::start(const asio::ip::tcp::endpoint& server, std::uint32_t vers
     if (ec) return fail("cannot connect: " + ec.message());
     boost::system::error_code ignored;
     socket_.set_option(asio::ip::tcp::no_delay(true), ignored);
-    send(protocol::encode_hello(name_, wants_player_, version));
+    send(protocol::encode_hello(name_, wants_player_, acknowledge_, version));
     do_read();
   });
 }

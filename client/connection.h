@@ -68,7 +68,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
   void start(const boost::asio::ip::tcp::endpoint& server, std::uint32_t version = protocol::kProtocolVersion);
   void send(protocol::Frame frame);
   void send_ping();
-  // Off: no Ack is sent, so every snapshot comes in full (as before deltas).
+  // Off: no Ack is sent, so every snapshot comes in full (as before deltas). Before start(), the Hello says so.
   void acknowledge_snapshots(bool on) { acknowledge_ = on; }
   // Reads at most this many bytes a second, as over a slow link; 0: as fast as they come.
   void limit_read_rate(double bytes_per_s) { read_rate_ = bytes_per_s; }

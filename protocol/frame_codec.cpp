@@ -183,10 +183,10 @@ std::string check_values(const wire::Message& m) {
 
 }  // namespace
 
-Frame encode_hello(std::string_view client_name, bool wants_player, std::uint32_t version) {
+Frame encode_hello(std::string_view client_name, bool wants_player, bool acknowledges, std::uint32_t version) {
   flatbuffers::FlatBufferBuilder b(128);
   const auto name = b.CreateString(client_name.data(), client_name.size());
-  return finish(b, wire::CreateHello(b, version, name, wants_player));
+  return finish(b, wire::CreateHello(b, version, name, wants_player, acknowledges));
 }
 
 Frame encode_player_input(std::uint32_t sequence, Vec3 velocity) {

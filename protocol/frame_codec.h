@@ -56,7 +56,8 @@ using SharedFrame = std::shared_ptr<const Frame>;
 enum class Direction { to_server, to_client };
 
 // ---- encoding: client -> server ----
-Frame encode_hello(std::string_view client_name, bool wants_player, std::uint32_t version = kProtocolVersion);
+Frame encode_hello(std::string_view client_name, bool wants_player, bool acknowledges,
+                   std::uint32_t version = kProtocolVersion);
 Frame encode_player_input(std::uint32_t sequence, Vec3 velocity);
 Frame encode_add_balls(std::uint32_t count);
 Frame encode_ping(std::uint32_t client_time_us);

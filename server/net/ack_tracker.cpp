@@ -6,23 +6,35 @@
 
 namespace fishtank::net {
 
-void AckTracker::sent(std::uint32_t tick, Clock::time_point now) {
+void AckTracker::sent(std::uint32_t tick, Clock::time_point now, std::size_t bytes) {
   sent_.push_back(tick);
   if (sent_.size() > protocol::kKeptBases) sent_.pop_front();
-  out_.push_back({tick, now});
+  if (out_.empty()) delivered_at_ = now;  // the link was idle: that time delivered nothing, and does not count
+  out_.push_back({tick, now, bytes, delivered_, delivered_at_});
   if (out_.size() > kMaxOut) out_.pop_front();
 }
 
 std::string AckTracker::acknowledged(std::uint32_t tick, bool want_keyframe, Clock::time_point now) {
   // The snapshot came back, and every one sent before it arrived too.
   const auto later = std::find_if(out_.begin(), out_.end(), [&](const Out& o) { return o.tick > tick; });
+  for (auto o = out_.begin(); o != later; ++o) delivered_ += o->bytes;
   if (later != out_.begin() && (later - 1)->tick == tick) {
-    const Clock::duration took = now - (later - 1)->at;
+    const Out& answered = *(later - 1);
+    const Clock::duration took = now - answered.at;
     // Slower ones before it can never be the quickest again; older ones have left the window.
     while (!round_trips_.empty() && round_trips_.back().took >= took) round_trips_.pop_back();
     while (!round_trips_.empty() && round_trips_.front().at < now - kRoundTripWindow) round_trips_.pop_front();
     round_trips_.push_back({now, took});
+    // The bytes answered since it went out, over the time they took: what the link carried meanwhile.
+    // Over kRateInterval at least: a receiver may take in a short burst faster than its link carries.
+    const double seconds =
+        std::chrono::duration<double>(std::max<Clock::duration>(now - answered.delivered_at, kRateInterval)).count();
+    const double rate = double(delivered_ - answered.delivered) / seconds;
+    while (!rates_.empty() && rates_.back().bytes_per_s <= rate) rates_.pop_back();
+    while (!rates_.empty() && rates_.front().at < now - kRoundTripWindow) rates_.pop_front();
+    rates_.push_back({now, rate});
   }
+  if (later != out_.begin()) delivered_at_ = now;
   out_.erase(out_.begin(), later);
   if (want_keyframe) {
     base_.reset();
@@ -62,13 +74,23 @@ std::optional<AckTracker::Clock::duration> AckTracker::quickest_round_trip() con
 }
 
 std::optional<AckTracker::Clock::time_point> AckTracker::oldest_unanswered() const {
-  if (round_trips_.empty() || out_.empty()) return std::nullopt;
+  if (!acknowledges() || out_.empty()) return std::nullopt;
   return out_.front().at;
 }
 
 bool AckTracker::may_send(Clock::time_point now) const {
-  if (round_trips_.empty() || out_.empty()) return true;  // a client that never acknowledges is not held
-  return now - out_.front().at <= round_trips_.front().took + kQueueAllowance || now - out_.back().at >= kLongestHold;
+  if (!acknowledges() || out_.empty()) return true;  // a client that never acknowledges is not held
+  if (now - out_.back().at >= kLongestHold) return true;
+  // Before its first round trip, one snapshot out: the first is a keyframe, the largest there is.
+  if (round_trips_.empty()) return false;
+  const Clock::duration quickest = round_trips_.front().took;
+  if (now - out_.front().at > quickest + kQueueAllowance) return false;  // queueing already
+  // Not more out than the link carries in a round trip (kRateInterval at least, as its rate) and the allowance.
+  std::uint64_t out_bytes = 0;
+  for (const Out& o : out_) out_bytes += o.bytes;
+  const double span =
+      std::chrono::duration<double>(std::max<Clock::duration>(quickest, kRateInterval) + kQueueAllowance).count();
+  return double(out_bytes) <= delivery_rate() * span;
 }
 
 }  // namespace fishtank::net

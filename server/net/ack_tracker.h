@@ -8,13 +8,18 @@
 // It also says when the next snapshot should wait. Over a link slower than the
 // snapshots, every one sent joins a queue in the sockets' buffers: the picture
 // falls seconds behind, its base leaves the kept ones and keyframes make it
-// worse. A client that acknowledges shows how long its snapshots take to come
-// back; while the oldest not yet acknowledged is out longer than the quickest
-// round trip of the last kRoundTripWindow plus kQueueAllowance, the link is
-// queueing and the newest snapshot waits for the next Ack instead, though never
-// longer than kLongestHold (a client that acknowledged only some snapshots
-// would otherwise wait for ever). A client that never acknowledges takes every
-// snapshot in full as its connection allows.
+// worse. A client that acknowledges shows what its link carries, as TCP's BBR
+// reads it: the quickest round trip of the last kRoundTripWindow, and the
+// fastest rate at which its Acks answered bytes over that window. While the
+// oldest snapshot out has been out kQueueAllowance longer than the quickest
+// round trip, or more bytes are out than that rate delivers in that round trip
+// plus kQueueAllowance, the link is queueing and the newest snapshot waits for
+// the next Ack instead, though never longer than kLongestHold (a client that
+// acknowledged only some snapshots would otherwise wait for ever). On a fast
+// link the measured rate grows with what is sent, so nothing waits. A client
+// that said in its Hello that it acknowledges is held from its first snapshot:
+// one out until its Ack, so a slow link starts without a queue. A client that
+// never acknowledges takes every snapshot in full as its connection allows.
 
 #include <chrono>
 #include <cstdint>
@@ -26,7 +31,10 @@ namespace fishtank::net {
 
 // How much longer than its quickest round trip a client's snapshots may take before they wait.
 inline constexpr std::chrono::milliseconds kQueueAllowance{50};
-// ... and the longest a snapshot waits since the last went out.
+// The shortest span a delivery rate is measured over, and a round trip counted at least in what may be out:
+// a receiver may take in a burst faster than its link carries it.
+inline constexpr std::chrono::milliseconds kRateInterval{100};
+// The longest a snapshot waits since the last went out.
 inline constexpr std::chrono::seconds kLongestHold{1};
 // The quickest round trip is of this span: a path that got slower (a phone roaming) is learnt within it.
 inline constexpr std::chrono::seconds kRoundTripWindow{10};
@@ -37,8 +45,10 @@ class AckTracker {
  public:
   using Clock = std::chrono::steady_clock;
 
-  // A Snapshot with this tick went out to the client at `now` (ticks rise).
-  void sent(std::uint32_t tick, Clock::time_point now);
+  // The client said in its Hello that it answers every snapshot with an Ack.
+  void expect_acks() { expects_acks_ = true; }
+  // A Snapshot with this tick and size went out to the client at `now` (ticks rise).
+  void sent(std::uint32_t tick, Clock::time_point now, std::size_t bytes);
   // Returns why the Ack cannot be true, empty when it is taken (or merely old).
   std::string acknowledged(std::uint32_t tick, bool want_keyframe, Clock::time_point now);
   // Empty: the next snapshot must be a keyframe (the client keeps only its newest kKeptBases too).
@@ -53,21 +63,37 @@ class AckTracker {
   void forget_unanswered() { out_.clear(); }
   // The quickest round trip of a snapshot and its Ack over kRoundTripWindow up to the newest; empty before the first.
   std::optional<Clock::duration> quickest_round_trip() const;
+  // The fastest the client's Acks answered bytes over kRoundTripWindow, bytes a second; 0 before the first.
+  double delivery_rate() const { return rates_.empty() ? 0.0 : rates_.front().bytes_per_s; }
+  // The client answers snapshots: it said so, or an Ack showed it.
+  bool acknowledges() const { return expects_acks_ || !round_trips_.empty(); }
 
  private:
   struct Out {
     std::uint32_t tick;
     Clock::time_point at;
+    std::size_t bytes;
+    // Bytes answered up to its sending, and when the last of them was: its Ack's rate is measured from there.
+    std::uint64_t delivered;
+    Clock::time_point delivered_at;
   };
   struct RoundTrip {
     Clock::time_point at;  // when the Ack came
     Clock::duration took;
+  };
+  struct Rate {
+    Clock::time_point at;  // when the Ack came
+    double bytes_per_s;
   };
 
   std::deque<std::uint32_t> sent_;  // the newest kKeptBases ticks sent, oldest first
   std::optional<std::uint32_t> base_;
   std::deque<Out> out_;  // sent and not acknowledged (any Ack of a later one counts: TCP keeps order), oldest first
   std::deque<RoundTrip> round_trips_;  // of the window: each quicker than every later one, so the first is quickest
+  std::deque<Rate> rates_;             // of the window: each faster than every later one, so the first is fastest
+  std::uint64_t delivered_ = 0;        // bytes of every snapshot answered so far
+  Clock::time_point delivered_at_{};   // when the last of them was
+  bool expects_acks_ = false;
 };
 
 }  // namespace fishtank::net

@@ -105,6 +105,7 @@ Outcome ClientProtocol::on_hello(const wire::Hello& hello) {
                       "; use a client and server from the same release",
                   /*disconnect=*/true);
   state_ = State::joining;
+  if (hello.acknowledges()) acks_.expect_acks();
   Outcome out;
   out.command = Command{client_id_, JoinCommand{hello.wants_player()}};
   out.log = "hello from '" + name_ + "'" + (hello.wants_player() ? ", wants a player sphere" : ", observing");

@@ -89,7 +89,9 @@ class ClientProtocol {
   Outcome on_evicted(const std::string& why);
 
   // A Snapshot with this tick went out to the client.
-  void on_snapshot_sent(std::uint32_t tick, Clock::time_point now = Clock::now()) { acks_.sent(tick, now); }
+  void on_snapshot_sent(std::uint32_t tick, std::size_t bytes, Clock::time_point now = Clock::now()) {
+    acks_.sent(tick, now, bytes);
+  }
   // False while the client's link is queueing snapshots (AckTracker): the newest waits for its next Ack.
   bool may_send_snapshot(Clock::time_point now = Clock::now()) const { return acks_.may_send(now); }
   // When the oldest snapshot the client has not answered went out; empty when none is, or it never answers.

@@ -110,7 +110,7 @@ void Session::do_write() {
       buffers.push_back(asio::buffer(writing_kinds_));
     }
     writing_snapshot_ = owner_.snapshot_frame(snapshot, protocol_.delta_base(), protocol_.delta_prior()).frame;
-    protocol_.on_snapshot_sent(snapshot->header.tick);
+    protocol_.on_snapshot_sent(snapshot->header.tick, writing_snapshot_->size());
     buffers.push_back(asio::buffer(*writing_snapshot_));
   }
   if (buffers.empty()) {

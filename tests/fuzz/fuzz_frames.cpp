@@ -55,7 +55,7 @@ bool carry_out(net::ClientProtocol& conversation, const net::Outcome& outcome) {
       check(protocol::decode_frame(reply.data(), reply.size(), protocol::Direction::to_client).ok());
     // Ticks 0 .. 39 sent, every fifth skipped: acks may be good, skipped, too old or in the future.
     for (std::uint32_t tick = 0; tick < 40; ++tick)
-      if (tick % 5 != 4) conversation.on_snapshot_sent(tick);
+      if (tick % 5 != 4) conversation.on_snapshot_sent(tick, 1000);
   }
   return !outcome.disconnect;
 }

@@ -45,8 +45,8 @@ int main(int argc, char** argv) {
   third_header.tick = 7;
 
   const std::vector<std::pair<std::string, protocol::Frame>> frames = {
-      {"hello", protocol::encode_hello("seed", true)},
-      {"hello_observer", protocol::encode_hello("seed", false)},
+      {"hello", protocol::encode_hello("seed", true, true)},
+      {"hello_observer", protocol::encode_hello("seed", false, false)},
       {"player_input", protocol::encode_player_input(1, {1.0f, -2.0f, 3.0f})},
       {"add_balls", protocol::encode_add_balls(1000)},
       {"ping", protocol::encode_ping(123456)},

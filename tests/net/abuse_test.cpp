@@ -111,7 +111,7 @@ void check_non_reader(bool sends, const std::string& code, const std::string& at
   ServerProcess server({"--balls", "500", "--snapshot-rate", "500", "--idle-timeout", "1"});
   auto honest = honest_viewer(server);
   RawSocket peer(server.port(), /*receive_buffer=*/4096);
-  peer.send(protocol::encode_hello("non-reader", false));
+  peer.send(protocol::encode_hello("non-reader", false, false));
   std::uint32_t sequence = 0;
   double seconds = 0.0;
   const double rate = snapshot_rate(*honest, [&] {
@@ -160,7 +160,7 @@ TEST_CASE("abuse: 500 peers say Hello, announce 1 MiB, send one byte and stall -
   const long rss_before = server.rss_kb();
   std::vector<std::unique_ptr<RawSocket>> peers;
   const double rate = snapshot_rate(*honest, [&] {
-    peers = stalled_peers(server.port(), 500, protocol::encode_hello("stalled", false));
+    peers = stalled_peers(server.port(), 500, protocol::encode_hello("stalled", false, false));
     std::this_thread::sleep_for(1500ms);
   });
   const long growth = rss_growth_kb(server, rss_before);
@@ -314,7 +314,7 @@ TEST_CASE("abuse: a Hello sent one byte at a time is cut off at the Hello deadli
   ServerProcess server({"--balls", "300", "--hello-timeout", "1"});
   auto honest = honest_viewer(server);
   RawSocket slow(server.port());
-  const protocol::Frame hello = protocol::encode_hello("slowloris", false);
+  const protocol::Frame hello = protocol::encode_hello("slowloris", false, false);
   std::vector<std::uint8_t> got;
   bool closed = false;
   const Clock::time_point start = Clock::now();

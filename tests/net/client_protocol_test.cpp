@@ -14,7 +14,7 @@ TEST_CASE("a client name with a newline or an escape code is logged escaped and 
   const net::ServerInfo info;
   net::ClientProtocol client(1, info);
   const std::string forged = "viewer\nt =    1.0 s  balls  9999\x1b[2K";
-  const protocol::Frame hello = protocol::encode_hello(forged, false);
+  const protocol::Frame hello = protocol::encode_hello(forged, false, false);
   client.on_frame(hello.data(), hello.size());
   const std::string& name = client.client_name();
   CHECK(name == "viewer\\x0at =    1.0 s  balls  9999\\x1b[2K");
@@ -37,7 +37,7 @@ TEST_CASE("before Hello a peer may announce 1 KiB at most, after it the general 
   };
   CHECK(announce(net::kMaxFirstFrameBytes));
   CHECK_FALSE(announce(net::kMaxFirstFrameBytes + 1));
-  const protocol::Frame hello = protocol::encode_hello("viewer", false);
+  const protocol::Frame hello = protocol::encode_hello("viewer", false, false);
   client.on_frame(hello.data(), hello.size());
   CHECK(announce(protocol::kMaxClientFrameBytes));
   CHECK_FALSE(announce(protocol::kMaxClientFrameBytes + 1));
@@ -47,7 +47,7 @@ TEST_CASE("a burst beyond --max-commands is a command flood, the same rate sprea
   net::ServerInfo info;
   info.limits.max_commands_per_s = 10.0;
   const auto t0 = net::ClientProtocol::Clock::now();
-  const protocol::Frame hello = protocol::encode_hello("viewer", false);
+  const protocol::Frame hello = protocol::encode_hello("viewer", false, false);
   const protocol::Frame ping = protocol::encode_ping(1);
 
   net::ClientProtocol steady(1, info);
@@ -76,7 +76,7 @@ TEST_CASE("a WebSocket message is a frame without its length prefix, under the s
   CHECK(client.on_unprefixed_frame(oversize.data(), oversize.size()).disconnect);  // before Hello: 1 KiB
 
   net::ClientProtocol web(2, info);
-  const protocol::Frame hello = protocol::encode_hello("browser", true);
+  const protocol::Frame hello = protocol::encode_hello("browser", true, false);
   const net::Outcome joined =
       web.on_unprefixed_frame(hello.data() + protocol::kLengthPrefixBytes, hello.size() - protocol::kLengthPrefixBytes);
   REQUIRE(joined.command);

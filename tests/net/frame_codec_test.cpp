@@ -23,13 +23,16 @@ protocol::DecodeResult decode(const protocol::Frame& f, Direction to) {
 
 TEST_CASE("every message survives encode then decode with its values intact", "[protocol]") {
   SECTION("Hello") {
-    const protocol::Frame f = protocol::encode_hello("viewer", true);
+    const protocol::Frame f = protocol::encode_hello("viewer", true, true);
     const auto r = decode(f, Direction::to_server);
     REQUIRE(r.ok());
     const wire::Hello& h = *r.message->payload_as_Hello();
     CHECK(h.protocol_version() == protocol::kProtocolVersion);
     CHECK(h.client_name()->str() == "viewer");
     CHECK(h.wants_player());
+    CHECK(h.acknowledges());
+    const protocol::Frame silent = protocol::encode_hello("script", false, false);
+    CHECK_FALSE(decode(silent, Direction::to_server).message->payload_as_Hello()->acknowledges());
   }
   SECTION("Welcome") {
     protocol::WelcomeInfo w;
@@ -180,7 +183,7 @@ TEST_CASE("frames a peer got wrong are refused with a status that says whether t
     CHECK(decode(f, Direction::to_server).status == DecodeStatus::malformed);
   }
   SECTION("a corrupted offset fails verification and breaks the stream") {
-    protocol::Frame f = protocol::encode_hello("x", false);
+    protocol::Frame f = protocol::encode_hello("x", false, false);
     f[4] = 0xf0;  // root offset points past the end
     CHECK(decode(f, Direction::to_server).status == DecodeStatus::malformed);
   }

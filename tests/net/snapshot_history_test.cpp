@@ -6,7 +6,9 @@
 #include "server/net/snapshot_history.h"
 
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <deque>
+#include <map>
 
 #include "protocol/received_snapshots.h"
 #include "server/net/ack_tracker.h"
@@ -37,7 +39,7 @@ struct SimulatedClient {
     }
     if (n % every != 0) return std::nullopt;
     const net::CodedSnapshot coded = history.frame(s, acks ? tracker.base() : std::nullopt);
-    tracker.sent(s->header.tick, {});
+    tracker.sent(s->header.tick, {}, coded.frame->size());
     const protocol::DecodeResult r =
         protocol::decode_frame(coded.frame->data(), coded.frame->size(), Direction::to_client);
     REQUIRE(r.ok());
@@ -142,7 +144,7 @@ TEST_CASE("an Ack the client cannot have meant gets an Error, then a keyframe, a
   info.dt = 0.001f;
   net::ClientProtocol conversation(1, info);
   const auto send = [&](const protocol::Frame& f) { return conversation.on_frame(f.data(), f.size()); };
-  REQUIRE(send(protocol::encode_hello("t", false)).command);
+  REQUIRE(send(protocol::encode_hello("t", false, false)).command);
   conversation.on_reply({1, net::JoinedReply{}});
   REQUIRE(conversation.welcomed());
   const auto refused = [](const net::Outcome& o) {
@@ -153,9 +155,9 @@ TEST_CASE("an Ack the client cannot have meant gets an Error, then a keyframe, a
            r.message->payload_as_Error()->code() == wire::ErrorCode::invalid_value;
   };
 
-  CHECK(refused(send(protocol::encode_ack(0))));                             // nothing sent yet
-  for (std::uint32_t t : {10u, 11u, 13u}) conversation.on_snapshot_sent(t);  // 12 was skipped for this client
-  CHECK_FALSE(conversation.delta_base());                                    // nothing acknowledged: keyframe
+  CHECK(refused(send(protocol::encode_ack(0))));                                   // nothing sent yet
+  for (std::uint32_t t : {10u, 11u, 13u}) conversation.on_snapshot_sent(t, 1000);  // 12 was skipped for this client
+  CHECK_FALSE(conversation.delta_base());                                          // nothing acknowledged: keyframe
   CHECK(send(protocol::encode_ack(11)).replies.empty());
   CHECK(conversation.delta_base() == 11u);
   CHECK(conversation.delta_prior() == 10u);               // the one sent before it, to predict moving balls from
@@ -179,7 +181,7 @@ TEST_CASE("an Ack the client cannot have meant gets an Error, then a keyframe, a
     CHECK_FALSE(conversation.delta_base());
   }
   SECTION("an ack older than any kept is harmless, and a base the client no longer keeps is none") {
-    for (std::uint32_t t = 20; t < 20 + protocol::kKeptBases; ++t) conversation.on_snapshot_sent(t);
+    for (std::uint32_t t = 20; t < 20 + protocol::kKeptBases; ++t) conversation.on_snapshot_sent(t, 1000);
     CHECK(send(protocol::encode_ack(13)).replies.empty());
     CHECK_FALSE(conversation.delta_base());  // 11 left the client's kept bases with the 32 sent since
     CHECK(send(protocol::encode_ack(40)).replies.empty());
@@ -208,55 +210,152 @@ TEST_CASE("a delta that would be larger than the full snapshot is sent in full",
 }
 
 TEST_CASE(
-    "snapshots to a client wait while its Acks lag its quickest round trip by more than the allowance, "
-    "a second at most",
+    "snapshots to a client wait while more bytes are out than its link carried in its quickest round trip plus "
+    "the allowance, a second at most",
     "[net][delta]") {
   using std::chrono::milliseconds;
   const net::AckTracker::Clock::time_point t0{};
   net::AckTracker tracker;
-  tracker.sent(1, t0);
-  tracker.sent(2, t0 + milliseconds(17));
+  tracker.sent(1, t0, 10'000);
+  tracker.sent(2, t0 + milliseconds(17), 10'000);
   CHECK(tracker.may_send(t0 + milliseconds(500)));  // nothing acknowledged yet: as for a client that never does
-  tracker.acknowledged(1, false, t0 + milliseconds(10));
-  CHECK(tracker.quickest_round_trip() == milliseconds(10));
-  // 2 is out: it may be out for 10 + 50 ms before the link counts as queueing.
-  CHECK(tracker.may_send(t0 + milliseconds(17 + 60)));
-  CHECK_FALSE(tracker.may_send(t0 + milliseconds(17 + 61)));
-  tracker.acknowledged(2, false, t0 + milliseconds(200));  // came back late: the quickest stays 10 ms
-  CHECK(tracker.quickest_round_trip() == milliseconds(10));
-  CHECK(tracker.may_send(t0 + milliseconds(200)));  // nothing out
+  tracker.acknowledged(1, false, t0 + milliseconds(100));
+  CHECK(tracker.quickest_round_trip() == milliseconds(100));
+  CHECK(tracker.delivery_rate() == Approx(100'000));  // 10 kB in 100 ms
+  // It carries 15 kB in 100 + 50 ms: 2 (10 kB) may be joined by another, and then the link is queueing.
+  CHECK(tracker.may_send(t0 + milliseconds(100)));
+  tracker.sent(3, t0 + milliseconds(117), 10'000);
+  CHECK_FALSE(tracker.may_send(t0 + milliseconds(117)));
+  tracker.acknowledged(2, false, t0 + milliseconds(200));  // came back later: the quickest stays 100 ms
+  CHECK(tracker.quickest_round_trip() == milliseconds(100));
+  CHECK(tracker.may_send(t0 + milliseconds(200)));
 
   // An Ack of a later snapshot answers the earlier ones too: TCP keeps their order.
-  tracker.sent(3, t0 + milliseconds(200));
-  tracker.sent(4, t0 + milliseconds(217));
+  tracker.sent(4, t0 + milliseconds(217), 10'000);
   CHECK_FALSE(tracker.may_send(t0 + milliseconds(300)));
-  tracker.acknowledged(4, false, t0 + milliseconds(305));
-  CHECK(tracker.may_send(t0 + milliseconds(305)));
+  tracker.acknowledged(4, false, t0 + milliseconds(400));
+  CHECK(tracker.may_send(t0 + milliseconds(400)));  // nothing out
 
   // A client that stops acknowledging is sent a snapshot a second.
-  tracker.sent(5, t0 + milliseconds(305));
-  CHECK_FALSE(tracker.may_send(t0 + milliseconds(1304)));
-  CHECK(tracker.may_send(t0 + milliseconds(1305)));
-  tracker.sent(6, t0 + milliseconds(1305));
-  CHECK_FALSE(tracker.may_send(t0 + milliseconds(1400)));
+  tracker.sent(5, t0 + milliseconds(400), 10'000);
+  tracker.sent(6, t0 + milliseconds(417), 10'000);
+  CHECK_FALSE(tracker.may_send(t0 + milliseconds(1416)));
+  CHECK(tracker.may_send(t0 + milliseconds(1417)));
+  tracker.sent(7, t0 + milliseconds(1417), 10'000);
+  CHECK_FALSE(tracker.may_send(t0 + milliseconds(1500)));
 
-  CHECK(tracker.oldest_unanswered() == t0 + milliseconds(305));  // what the idle watchdog counts from
+  CHECK(tracker.oldest_unanswered() == t0 + milliseconds(400));  // what the idle watchdog counts from
   // A keyframe asked for is an answer as well.
-  tracker.acknowledged(6, true, t0 + milliseconds(1400));
-  CHECK(tracker.may_send(t0 + milliseconds(1400)));
+  tracker.acknowledged(7, true, t0 + milliseconds(1500));
+  CHECK(tracker.may_send(t0 + milliseconds(1500)));
   CHECK_FALSE(tracker.base());
   CHECK_FALSE(tracker.oldest_unanswered());
   // Watching off: what is out needs no answer.
-  tracker.sent(7, t0 + milliseconds(1500));
+  tracker.sent(8, t0 + milliseconds(1600), 10'000);
   tracker.forget_unanswered();
   CHECK_FALSE(tracker.oldest_unanswered());
-  CHECK(tracker.may_send(t0 + milliseconds(1600)));
+  CHECK(tracker.may_send(t0 + milliseconds(1700)));
 
   // The quickest is of the last 10 s: a path that got slower is learnt.
-  for (std::uint32_t tick = 8; tick < 20; ++tick) {
+  for (std::uint32_t tick = 9; tick < 21; ++tick) {
     const auto sent = t0 + std::chrono::seconds(tick);
-    tracker.sent(tick, sent);
-    tracker.acknowledged(tick, false, sent + milliseconds(100));
+    tracker.sent(tick, sent, 10'000);
+    tracker.acknowledged(tick, false, sent + milliseconds(200));
   }
-  CHECK(tracker.quickest_round_trip() == milliseconds(100));
+  CHECK(tracker.quickest_round_trip() == milliseconds(200));
+  CHECK(tracker.delivery_rate() == Approx(50'000));
+}
+
+namespace {
+
+struct LinkRun {
+  int sent_last_second = 0;
+  double slowest_round_trip_last_second = 0.0;  // seconds
+};
+
+// A client behind a link of `bytes_per_s` (0: no limit) and `latency` each way, offered a snapshot of
+// `frame_bytes` every 1/60 s for 10 s, acknowledging each as it arrives, on a clock of 0.1 ms ticks.
+LinkRun run_link(double bytes_per_s, double latency, std::size_t frame_bytes) {
+  using Clock = net::AckTracker::Clock;
+  const auto at = [](double s) { return Clock::time_point{} + std::chrono::microseconds(std::lround(s * 1e6)); };
+  net::AckTracker tracker;
+  tracker.expect_acks();
+  std::deque<std::pair<double, std::uint32_t>> acks;  // (reaches the server at, tick)
+  std::map<std::uint32_t, double> sent_at;
+  double link_free = 0.0, next_offer = 0.0;
+  bool offered = false;
+  std::uint32_t tick = 0;
+  LinkRun run;
+  for (double now = 0.0; now < 10.0; now += 1e-4) {
+    for (; !acks.empty() && acks.front().first <= now; acks.pop_front()) {
+      tracker.acknowledged(acks.front().second, false, at(now));
+      if (now >= 9.0)
+        run.slowest_round_trip_last_second =
+            std::max(run.slowest_round_trip_last_second, now - sent_at[acks.front().second]);
+    }
+    if (now >= next_offer) {
+      offered = true;  // the newest replaces one still held
+      next_offer += 1.0 / 60.0;
+    }
+    if (!offered || !tracker.may_send(at(now))) continue;
+    offered = false;
+    tracker.sent(++tick, at(now), frame_bytes);
+    sent_at[tick] = now;
+    run.sent_last_second += now >= 9.0;
+    link_free = std::max(link_free, now + latency) + (bytes_per_s > 0.0 ? frame_bytes / bytes_per_s : 0.0);
+    acks.emplace_back(link_free + latency, tick);
+  }
+  return run;
+}
+
+}  // namespace
+
+TEST_CASE("paced by its Acks, a slow link gets what it carries without a queue, and a fast one every snapshot",
+          "[net][delta]") {
+  // 20 kB snapshots over 50 kB/s: 2.5 a second, each 0.4 s on the link; a queue would grow by 57 kB a second.
+  const LinkRun slow = run_link(50'000, 0.005, 20'000);
+  CHECK(slow.sent_last_second >= 2);
+  CHECK(slow.slowest_round_trip_last_second < 2 * 0.4 + 0.1);  // one snapshot ahead at most
+  // 150 kB/s, 16 kB: as 6000 settled balls.
+  const LinkRun medium = run_link(150'000, 0.005, 16'000);
+  CHECK(medium.sent_last_second >= 8);
+  CHECK(medium.slowest_round_trip_last_second < 2 * 16.0 / 150 + 0.1);
+  // Far but fast (100 ms each way): six round trips' worth out at once, and all 60 a second arrive.
+  const LinkRun far = run_link(0.0, 0.1, 36'000);
+  CHECK(far.sent_last_second >= 59);
+  CHECK(far.slowest_round_trip_last_second < 0.21);
+  // 20 ms each way: a round trip spans more than one snapshot, and still all 60 a second arrive.
+  CHECK(run_link(0.0, 0.02, 36'000).sent_last_second >= 59);
+  // Loopback.
+  CHECK(run_link(0.0, 0.00005, 36'000).sent_last_second >= 59);
+}
+
+TEST_CASE("a client that says in its Hello it acknowledges has one snapshot out until its first Ack, a second at most",
+          "[net][delta]") {
+  using std::chrono::milliseconds;
+  const net::AckTracker::Clock::time_point t0{};
+  net::AckTracker tracker;
+  tracker.expect_acks();
+  CHECK(tracker.may_send(t0));  // nothing out
+  tracker.sent(1, t0, 36'000);
+  // Over a slow link the first keyframe takes long to arrive: the next waits for its Ack instead of queueing.
+  CHECK_FALSE(tracker.may_send(t0 + milliseconds(17)));
+  CHECK_FALSE(tracker.may_send(t0 + milliseconds(999)));
+  CHECK(tracker.oldest_unanswered() == t0);  // the idle watchdog counts from the first snapshot
+  tracker.acknowledged(1, false, t0 + milliseconds(300));
+  CHECK(tracker.quickest_round_trip() == milliseconds(300));
+  CHECK(tracker.may_send(t0 + milliseconds(300)));
+  // From then on its link paces it, as any client that acknowledges: 120 kB/s carries 42 kB in 300 + 50 ms.
+  CHECK(tracker.delivery_rate() == Approx(120'000));
+  tracker.sent(2, t0 + milliseconds(300), 16'000);
+  tracker.sent(3, t0 + milliseconds(317), 16'000);
+  CHECK(tracker.may_send(t0 + milliseconds(334)));
+  tracker.sent(4, t0 + milliseconds(334), 16'000);
+  CHECK_FALSE(tracker.may_send(t0 + milliseconds(351)));
+
+  // One that never answers gets a snapshot a second.
+  net::AckTracker silent;
+  silent.expect_acks();
+  silent.sent(1, t0, 36'000);
+  CHECK(silent.may_send(t0 + std::chrono::seconds(1)));
 }

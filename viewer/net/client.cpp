@@ -104,7 +104,7 @@ void NetClient::do_connect() {
           if (gen != generation_) return;
           if (ec) return lose("cannot connect: " + ec.message());
           socket_.set_option(tcp::no_delay(true), ec);  // small inputs go out at once
-          send(protocol::encode_hello("fishtank-viewer", wants_player_));
+          send(protocol::encode_hello("fishtank-viewer", wants_player_, /*acknowledges=*/true));
           do_read_prefix();
         });
       });

@@ -19,8 +19,9 @@ function frame(type: Payload, build: (b: Builder) => number): Uint8Array {
   return b.asUint8Array();
 }
 
+// The page acknowledges every snapshot it decodes, so the server may pace it from the first.
 export const hello = (name: string, wantsPlayer: boolean): Uint8Array =>
-  frame(Payload.Hello, (b) => Hello.createHello(b, PROTOCOL_VERSION, b.createString(name), wantsPlayer));
+  frame(Payload.Hello, (b) => Hello.createHello(b, PROTOCOL_VERSION, b.createString(name), wantsPlayer, true));
 
 export const ack = (tick: number, wantKeyframe = false): Uint8Array =>
   frame(Payload.Ack, (b) => Ack.createAck(b, tick, wantKeyframe));
