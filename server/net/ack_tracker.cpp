@@ -68,6 +68,11 @@ std::optional<std::uint32_t> AckTracker::prior() const {
   return *(at - 1);
 }
 
+bool AckTracker::keeps(std::uint32_t tick) const {
+  const std::optional<std::uint32_t> held = base();
+  return held && tick <= *held && std::binary_search(sent_.begin(), sent_.end(), tick);
+}
+
 std::optional<AckTracker::Clock::duration> AckTracker::quickest_round_trip() const {
   if (round_trips_.empty()) return std::nullopt;
   return round_trips_.front().took;

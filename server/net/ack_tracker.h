@@ -55,6 +55,8 @@ class AckTracker {
   std::optional<std::uint32_t> base() const;
   // The snapshot sent before base(), which the client holds too; empty when none is known.
   std::optional<std::uint32_t> prior() const;
+  // Whether the client holds snapshot `tick`: sent to it among the last kKeptBases, and not after base().
+  bool keeps(std::uint32_t tick) const;
   // False while the link is queueing: the next snapshot waits for an Ack.
   bool may_send(Clock::time_point now) const;
   // When the oldest snapshot not yet answered went out, for a client that acknowledges; empty when none is out.

@@ -100,6 +100,8 @@ class ClientProtocol {
   std::optional<std::uint32_t> delta_base() const { return acks_.base(); }
   // The snapshot sent before that one, to predict moving balls from; empty: none.
   std::optional<std::uint32_t> delta_prior() const { return acks_.prior(); }
+  // Whether the client holds snapshot `tick`, to decode a frame coded for another client against.
+  bool keeps(std::uint32_t tick) const { return acks_.keeps(tick); }
 
   // True from the Welcome on: the client gets snapshots (while it is watching).
   bool welcomed() const { return state_ == State::active; }

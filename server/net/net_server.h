@@ -67,8 +67,9 @@ class NetServer final : public SessionOwner {
   void bytes_sent(std::size_t bytes) override;
   void snapshot_skipped() override { snapshots_skipped_.fetch_add(1, std::memory_order_relaxed); }
   CodedSnapshot snapshot_frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base,
-                               std::optional<std::uint32_t> prior) override {
-    return history_.frame(snapshot, base, prior);
+                               std::optional<std::uint32_t> prior,
+                               const std::function<bool(std::uint32_t)>& keeps) override {
+    return history_.frame(snapshot, base, prior, keeps);
   }
   // Coding of snapshot frames so far; safe to read from any thread.
   const FrameStats& frame_stats() const { return history_.stats(); }

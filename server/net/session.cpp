@@ -109,7 +109,10 @@ void Session::do_write() {
       kinds_sent_ = balls;
       buffers.push_back(asio::buffer(writing_kinds_));
     }
-    writing_snapshot_ = owner_.snapshot_frame(snapshot, protocol_.delta_base(), protocol_.delta_prior()).frame;
+    writing_snapshot_ = owner_
+                            .snapshot_frame(snapshot, protocol_.delta_base(), protocol_.delta_prior(),
+                                            [this](std::uint32_t tick) { return protocol_.keeps(tick); })
+                            .frame;
     protocol_.on_snapshot_sent(snapshot->header.tick, writing_snapshot_->size());
     buffers.push_back(asio::buffer(*writing_snapshot_));
   }

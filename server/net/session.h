@@ -26,6 +26,7 @@
 #include <chrono>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -50,8 +51,10 @@ class SessionOwner {
   // A snapshot offered to a session was replaced by a newer one before it could go out: a slow link or reader.
   virtual void snapshot_skipped() = 0;
   // The frame of snapshot for a client that holds snapshots `base` (empty: none) and `prior`.
+  // `keeps`: which other snapshots the client holds, so that a frame coded for another may serve it.
   virtual CodedSnapshot snapshot_frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base,
-                                       std::optional<std::uint32_t> prior) = 0;
+                                       std::optional<std::uint32_t> prior,
+                                       const std::function<bool(std::uint32_t)>& keeps) = 0;
 };
 
 class Session : public std::enable_shared_from_this<Session> {

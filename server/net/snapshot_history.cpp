@@ -29,19 +29,35 @@ const PublishedSnapshot* SnapshotHistory::find(std::uint32_t tick) const {
 }
 
 CodedSnapshot SnapshotHistory::frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base,
-                                     std::optional<std::uint32_t> prior) {
+                                     std::optional<std::uint32_t> prior,
+                                     const std::function<bool(std::uint32_t)>& keeps) {
   const PublishedSnapshot* base_snapshot = base && *base < snapshot->header.tick ? find(*base) : nullptr;
   const PublishedSnapshot* prior_snapshot = base_snapshot && prior && *prior < *base ? find(*prior) : nullptr;
   if (!base_snapshot) base.reset();  // a keyframe
   if (!prior_snapshot) prior.reset();
   const References references{base, prior};
   const bool newest = !kept_.empty() && kept_.back() == snapshot;
-  if (newest)
+  if (newest) {
     for (const auto& [cached, coded] : cache_)
       if (cached == references) return coded;
+    if (const CodedSnapshot* shared = shareable(base, keeps)) return *shared;
+  }
   CodedSnapshot coded = code(*snapshot, base_snapshot, prior_snapshot);
   if (newest) cache_.emplace_back(references, coded);
   return coded;
+}
+
+const CodedSnapshot* SnapshotHistory::shareable(std::optional<std::uint32_t> base,
+                                                const std::function<bool(std::uint32_t)>& keeps) const {
+  if (!base || !keeps) return nullptr;
+  const std::pair<References, CodedSnapshot>* newest = nullptr;
+  for (const auto& entry : cache_) {
+    const auto& [other_base, other_prior] = entry.first;
+    if (!other_base || *other_base > *base || *base - *other_base > kShareLag) continue;
+    if (!keeps(*other_base) || (other_prior && !keeps(*other_prior))) continue;
+    if (!newest || *other_base > *newest->first.first) newest = &entry;
+  }
+  return newest ? &newest->second : nullptr;
 }
 
 CodedSnapshot SnapshotHistory::code(const PublishedSnapshot& s, const PublishedSnapshot* base,

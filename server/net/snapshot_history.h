@@ -8,13 +8,17 @@
 //
 // Every client that acknowledged the same snapshot gets the same bytes, so
 // coding costs once per distinct base, not per client: on a quiet network all
-// clients acknowledge the previous snapshot and one delta serves them all. The
-// per-client part is a lookup in a cache of a few entries.
+// clients acknowledge the previous snapshot and one delta serves them all. A
+// client that still keeps the base and prior of a frame already coded, at most
+// kShareLag older than its own base, gets that frame too: paced clients
+// acknowledge different snapshots, and a frame of 100 000 balls takes
+// milliseconds to code. The per-client part is a lookup in a cache of a few entries.
 
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -45,16 +49,24 @@ class SnapshotHistory {
   // Bases kept at most, whatever their size, so that a huge tank keeps fewer
   // snapshots rather than gigabytes.
   static constexpr std::size_t kMaxBytes = std::size_t{256} << 20;
+  // How many snapshots older than a client's own base another's frame may be coded against and still serve
+  // it: a delta from further back is larger.
+  static constexpr std::uint32_t kShareLag = 6;
 
   void publish(SharedSnapshot snapshot);
   // The frame of `snapshot` for a client that holds `base` (empty: none) and
-  // `prior`, the snapshot sent to it before base (empty: none).
+  // `prior`, the snapshot sent to it before base (empty: none); `keeps` says
+  // which other snapshots it holds (empty: none).
   CodedSnapshot frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base,
-                      std::optional<std::uint32_t> prior = std::nullopt);
+                      std::optional<std::uint32_t> prior = std::nullopt,
+                      const std::function<bool(std::uint32_t)>& keeps = nullptr);
   const FrameStats& stats() const { return stats_; }
 
  private:
   const PublishedSnapshot* find(std::uint32_t tick) const;
+  // A cached frame of the newest snapshot that a client with `base` that `keeps` these can decode; null: none.
+  const CodedSnapshot* shareable(std::optional<std::uint32_t> base,
+                                 const std::function<bool(std::uint32_t)>& keeps) const;
   CodedSnapshot code(const PublishedSnapshot& snapshot, const PublishedSnapshot* base, const PublishedSnapshot* prior);
 
   std::deque<SharedSnapshot> kept_;  // oldest first; the newest published is last

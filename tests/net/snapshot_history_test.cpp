@@ -38,7 +38,9 @@ struct SimulatedClient {
       acks_in_flight.pop_front();
     }
     if (n % every != 0) return std::nullopt;
-    const net::CodedSnapshot coded = history.frame(s, acks ? tracker.base() : std::nullopt);
+    const net::CodedSnapshot coded =
+        acks ? history.frame(s, tracker.base(), tracker.prior(), [&](std::uint32_t t) { return tracker.keeps(t); })
+             : history.frame(s, std::nullopt);
     tracker.sent(s->header.tick, {}, coded.frame->size());
     const protocol::DecodeResult r =
         protocol::decode_frame(coded.frame->data(), coded.frame->size(), Direction::to_client);
@@ -79,7 +81,8 @@ TEST_CASE("over a pour, a settle and a plough, every delta decodes to the full s
       history.publish(snapshot);
       const auto full = clients[3].receive(n, history, snapshot);
       REQUIRE(*full == snapshot->quantised);
-      for (int c = 0; c < 3; ++c)
+      // The slower clients first: the first, a newer base, then decodes their frames where it keeps their bases.
+      for (int c = 2; c >= 0; --c)
         if (const auto decoded = clients[c].receive(n, history, snapshot)) {
           REQUIRE(*decoded == *full);
           ++compared;
@@ -96,6 +99,8 @@ TEST_CASE("over a pour, a settle and a plough, every delta decodes to the full s
   run(1.0);  // ...and through it
 
   CHECK(compared > 500);
+  // Frames are shared: coded one per client, n keyframes and n + n + n / 3 deltas would be 3.3 n.
+  CHECK(history.stats().frames <= 3u * static_cast<std::uint64_t>(n) + 1);
   INFO("bytes per ball per snapshot: " << clients[0].bytes_per_ball() << " as deltas, " << clients[3].bytes_per_ball()
                                        << " in full");
   CHECK(clients[3].bytes_per_ball() > 6.0);
@@ -134,6 +139,49 @@ TEST_CASE("clients that acknowledged the same snapshot share one frame, and an u
     CHECK_FALSE(history.frame(later, 7).keyframe);  // more than 32 ago: a base of a client that got few of them
     CHECK_FALSE(history.frame(later, 6 + net::SnapshotHistory::kKeptPublished - 1).keyframe);
   }
+}
+
+TEST_CASE("a client that keeps another's base and prior gets the frame coded for it, within kShareLag",
+          "[net][delta]") {
+  net::SnapshotHistory history;
+  const auto snapshot_at = [](std::uint32_t tick) {
+    auto s = std::make_shared<net::PublishedSnapshot>();
+    s->header.tick = tick;
+    s->ball_count = 2;
+    s->quantised = {1, 2, 3, 4, 5, static_cast<std::uint16_t>(10 * tick)};
+    return net::SharedSnapshot(s);
+  };
+  for (std::uint32_t t = 0; t < 20; ++t) history.publish(snapshot_at(t));
+  const net::SharedSnapshot newest = snapshot_at(20);
+  history.publish(newest);
+  // A acknowledged 12 (11 sent before it); B, sent every snapshot, acknowledged 18 and keeps 10 .. 18.
+  const auto keeps_from = [](std::uint32_t first, std::uint32_t last) {
+    return [=](std::uint32_t t) { return t >= first && t <= last; };
+  };
+  const net::CodedSnapshot a = history.frame(newest, 12, 11, keeps_from(11, 12));
+  const net::CodedSnapshot b = history.frame(newest, 18, 17, keeps_from(10, 18));
+  CHECK(b.frame == a.frame);  // coded once
+  CHECK(history.stats().frames == 1);
+  protocol::ReceivedSnapshots received;  // B's side: it decodes A's frame from what it keeps
+  std::vector<std::uint16_t> positions;
+  for (std::uint32_t t = 10; t <= 18; ++t) {
+    const net::CodedSnapshot full = history.frame(snapshot_at(t), std::nullopt);
+    REQUIRE(received
+                .positions(*protocol::decode_frame(full.frame->data(), full.frame->size(), Direction::to_client)
+                                .message->payload_as_Snapshot(),
+                           positions)
+                .empty());
+  }
+  const protocol::DecodeResult r = protocol::decode_frame(b.frame->data(), b.frame->size(), Direction::to_client);
+  REQUIRE(received.positions(*r.message->payload_as_Snapshot(), positions).empty());
+  CHECK(positions == newest->quantised);
+
+  // Not shared: a client that was not sent A's prior, one whose base is newer than kShareLag allows, one that
+  // says nothing of what it keeps.
+  static_assert(12 + net::SnapshotHistory::kShareLag < 19);
+  CHECK(history.frame(newest, 18, 17, keeps_from(12, 18)).frame != a.frame);
+  CHECK(history.frame(newest, 19, 18, keeps_from(10, 19)).frame != a.frame);
+  CHECK(history.frame(newest, 16, 15).frame != a.frame);
 }
 
 TEST_CASE("an Ack the client cannot have meant gets an Error, then a keyframe, and the connection stays",
