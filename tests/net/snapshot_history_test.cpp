@@ -57,6 +57,15 @@ struct SimulatedClient {
   double bytes_per_ball() const { return ball_snapshots ? static_cast<double>(bytes) / ball_snapshots : 0.0; }
 };
 
+// Snapshot `tick` of two balls, the second's z at `z`.
+net::SharedSnapshot two_balls(std::uint32_t tick, std::uint16_t z) {
+  auto s = std::make_shared<net::PublishedSnapshot>();
+  s->header.tick = tick;
+  s->ball_count = 2;
+  s->quantised = {1, 2, 3, 4, 5, z};
+  return s;
+}
+
 }  // namespace
 
 TEST_CASE("over a pour, a settle and a plough, every delta decodes to the full snapshot's positions", "[net][delta]") {
@@ -110,13 +119,7 @@ TEST_CASE("over a pour, a settle and a plough, every delta decodes to the full s
 TEST_CASE("clients that acknowledged the same snapshot share one frame, and an unknown base gets a keyframe",
           "[net][delta]") {
   net::SnapshotHistory history;
-  const auto snapshot_at = [](std::uint32_t tick) {
-    auto s = std::make_shared<net::PublishedSnapshot>();
-    s->header.tick = tick;
-    s->ball_count = 2;
-    s->quantised = {1, 2, 3, 4, 5, static_cast<std::uint16_t>(tick)};
-    return net::SharedSnapshot(s);
-  };
+  const auto snapshot_at = [](std::uint32_t tick) { return two_balls(tick, static_cast<std::uint16_t>(tick)); };
   for (std::uint32_t t = 0; t < 5; ++t) history.publish(snapshot_at(t));
   const net::SharedSnapshot newest = snapshot_at(5);
   history.publish(newest);
@@ -144,13 +147,7 @@ TEST_CASE("clients that acknowledged the same snapshot share one frame, and an u
 TEST_CASE("a client that keeps another's base and prior gets the frame coded for it, within kShareLag",
           "[net][delta]") {
   net::SnapshotHistory history;
-  const auto snapshot_at = [](std::uint32_t tick) {
-    auto s = std::make_shared<net::PublishedSnapshot>();
-    s->header.tick = tick;
-    s->ball_count = 2;
-    s->quantised = {1, 2, 3, 4, 5, static_cast<std::uint16_t>(10 * tick)};
-    return net::SharedSnapshot(s);
-  };
+  const auto snapshot_at = [](std::uint32_t tick) { return two_balls(tick, static_cast<std::uint16_t>(10 * tick)); };
   for (std::uint32_t t = 0; t < 20; ++t) history.publish(snapshot_at(t));
   const net::SharedSnapshot newest = snapshot_at(20);
   history.publish(newest);
