@@ -21,18 +21,13 @@ std::string AckTracker::acknowledged(std::uint32_t tick, bool want_keyframe, Clo
   if (later != out_.begin() && (later - 1)->tick == tick) {
     const Out& answered = *(later - 1);
     const Clock::duration took = now - answered.at;
-    // Slower ones before it can never be the quickest again; older ones have left the window.
-    while (!round_trips_.empty() && round_trips_.back().took >= took) round_trips_.pop_back();
-    while (!round_trips_.empty() && round_trips_.front().at < now - kRoundTripWindow) round_trips_.pop_front();
-    round_trips_.push_back({now, took});
+    round_trips_.add(now, took);
     // The bytes answered since it went out, over the time they took: what the link carried meanwhile.
     // Over kRateInterval at least: a receiver may take in a short burst faster than its link carries.
     const double seconds =
         std::chrono::duration<double>(std::max<Clock::duration>(now - answered.delivered_at, kRateInterval)).count();
     const double rate = double(delivered_ - answered.delivered) / seconds;
-    while (!rates_.empty() && rates_.back().bytes_per_s <= rate) rates_.pop_back();
-    while (!rates_.empty() && rates_.front().at < now - kRoundTripWindow) rates_.pop_front();
-    rates_.push_back({now, rate});
+    rates_.add(now, rate);
   }
   if (later != out_.begin()) delivered_at_ = now;
   out_.erase(out_.begin(), later);
@@ -73,10 +68,7 @@ bool AckTracker::keeps(std::uint32_t tick) const {
   return held && tick <= *held && std::binary_search(sent_.begin(), sent_.end(), tick);
 }
 
-std::optional<AckTracker::Clock::duration> AckTracker::quickest_round_trip() const {
-  if (round_trips_.empty()) return std::nullopt;
-  return round_trips_.front().took;
-}
+std::optional<AckTracker::Clock::duration> AckTracker::quickest_round_trip() const { return round_trips_.best(); }
 
 std::optional<AckTracker::Clock::time_point> AckTracker::oldest_unanswered() const {
   if (!acknowledges() || out_.empty()) return std::nullopt;
@@ -87,8 +79,8 @@ bool AckTracker::may_send(Clock::time_point now) const {
   if (!acknowledges() || out_.empty()) return true;  // a client that never acknowledges is not held
   if (now - out_.back().at >= kLongestHold) return true;
   // Before its first round trip, one snapshot out: the first is a keyframe, the largest there is.
-  if (round_trips_.empty()) return false;
-  const Clock::duration quickest = round_trips_.front().took;
+  if (!round_trips_.best()) return false;
+  const Clock::duration quickest = *round_trips_.best();
   if (now - out_.front().at > quickest + kQueueAllowance) return false;  // queueing already
   // Not more out than the link carries in a round trip (kRateInterval at least, as its rate) and the allowance.
   std::uint64_t out_bytes = 0;

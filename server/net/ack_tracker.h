@@ -24,8 +24,10 @@
 #include <chrono>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 
 namespace fishtank::net {
 
@@ -66,9 +68,9 @@ class AckTracker {
   // The quickest round trip of a snapshot and its Ack over kRoundTripWindow up to the newest; empty before the first.
   std::optional<Clock::duration> quickest_round_trip() const;
   // The fastest the client's Acks answered bytes over kRoundTripWindow, bytes a second; 0 before the first.
-  double delivery_rate() const { return rates_.empty() ? 0.0 : rates_.front().bytes_per_s; }
+  double delivery_rate() const { return rates_.best().value_or(0.0); }
   // The client answers snapshots: it said so, or an Ack showed it.
-  bool acknowledges() const { return expects_acks_ || !round_trips_.empty(); }
+  bool acknowledges() const { return expects_acks_ || round_trips_.best(); }
 
  private:
   struct Out {
@@ -79,22 +81,29 @@ class AckTracker {
     std::uint64_t delivered;
     Clock::time_point delivered_at;
   };
-  struct RoundTrip {
-    Clock::time_point at;  // when the Ack came
-    Clock::duration took;
-  };
-  struct Rate {
-    Clock::time_point at;  // when the Ack came
-    double bytes_per_s;
+  // The best of the values added over the last kRoundTripWindow (Better: std::less, the least).
+  template <class T, class Better>
+  class WindowBest {
+   public:
+    void add(Clock::time_point now, T value) {
+      // Worse ones before it can never be the best again; older ones have left the window.
+      while (!kept_.empty() && !Better{}(kept_.back().second, value)) kept_.pop_back();
+      while (!kept_.empty() && kept_.front().first < now - kRoundTripWindow) kept_.pop_front();
+      kept_.emplace_back(now, value);
+    }
+    std::optional<T> best() const { return kept_.empty() ? std::nullopt : std::optional<T>(kept_.front().second); }
+
+   private:
+    std::deque<std::pair<Clock::time_point, T>> kept_;  // each better than every later one: the first is best
   };
 
   std::deque<std::uint32_t> sent_;  // the newest kKeptBases ticks sent, oldest first
   std::optional<std::uint32_t> base_;
   std::deque<Out> out_;  // sent and not acknowledged (any Ack of a later one counts: TCP keeps order), oldest first
-  std::deque<RoundTrip> round_trips_;  // of the window: each quicker than every later one, so the first is quickest
-  std::deque<Rate> rates_;             // of the window: each faster than every later one, so the first is fastest
-  std::uint64_t delivered_ = 0;        // bytes of every snapshot answered so far
-  Clock::time_point delivered_at_{};   // when the last of them was
+  WindowBest<Clock::duration, std::less<>> round_trips_;  // of snapshots and their Acks, when the Ack came
+  WindowBest<double, std::greater<>> rates_;              // bytes a second the Acks answered
+  std::uint64_t delivered_ = 0;                           // bytes of every snapshot answered so far
+  Clock::time_point delivered_at_{};                      // when the last of them was
   bool expects_acks_ = false;
 };
 
