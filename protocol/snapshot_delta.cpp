@@ -20,74 +20,68 @@ std::int32_t unzigzag(std::uint32_t z) { return static_cast<std::int32_t>(z >> 1
 
 int floor_log2(std::uint32_t v) { return 31 - __builtin_clz(v); }
 
+// Writes into a buffer sized beforehand for the longest stream the codes can
+// make, 8 bytes at every code and no branch: growing a vector per word was the
+// coder's main cost, and a branch per word its next.
 class BitWriter {
  public:
-  explicit BitWriter(std::vector<std::uint8_t>& out) : out_(out) {}
+  explicit BitWriter(std::uint8_t* out) : out_(out) {}
 
-  // bits <= 32. Whole 32-bit words go out at once: byte by byte was the coder's main cost.
+  // bits <= 56: with at most 7 bits pending, the 64-bit accumulator holds them all.
   void put(std::uint64_t value, int bits) {
     acc_ |= value << fill_;
     fill_ += bits;
-    if (fill_ < 32) return;
-    const std::uint8_t word[4] = {static_cast<std::uint8_t>(acc_), static_cast<std::uint8_t>(acc_ >> 8),
-                                  static_cast<std::uint8_t>(acc_ >> 16), static_cast<std::uint8_t>(acc_ >> 24)};
-    out_.insert(out_.end(), word, word + 4);
-    acc_ >>= 32;
-    fill_ -= 32;
+    for (int b = 0; b < 8; ++b) out_[b] = static_cast<std::uint8_t>(acc_ >> (8 * b));  // one store on x86
+    out_ += fill_ >> 3;
+    acc_ >>= fill_ & ~7;
+    fill_ &= 7;
   }
-  // Order k: v >> k as below, then the k low bits of v.
+  // Order k, in one code of at most kMaxCodeBits: n zeros, a one, the n bits of
+  // y = (v >> k) + 1 below its leading one, then the k low bits of v.
   void exp_golomb(std::uint32_t v, int k) {
-    exp_golomb(v >> k);
-    if (k > 0) put(v & ((1u << k) - 1), k);
+    const std::uint64_t y = (v >> k) + 1;
+    const int n = floor_log2(static_cast<std::uint32_t>(y));
+    const std::uint64_t low_k = v & ((1u << k) - 1);
+    const std::uint64_t low = y ^ (std::uint64_t{1} << n);
+    put((low << 1 | 1) << n | low_k << (2 * n + 1), 2 * n + 1 + k);
   }
-  // n zeros, a one, then the n bits of v + 1 below its leading one.
-  void exp_golomb(std::uint32_t v) {
-    const std::uint32_t y = v + 1;
-    const int n = floor_log2(y);
-    const std::uint64_t low = y & ((1u << n) - 1);
-    if (2 * n + 1 <= 32) return put(low << (n + 1) | 1u << n, 2 * n + 1);
-    put(1u << n, n + 1);
-    put(low, n);
-  }
-  void flush() {
-    for (; fill_ > 0; fill_ -= 8, acc_ >>= 8) out_.push_back(static_cast<std::uint8_t>(acc_));
-    acc_ = 0;
-    fill_ = 0;
+  // The bytes written, the last padded with zeros.
+  std::size_t flush() {
+    if (fill_ > 0) *out_++ = static_cast<std::uint8_t>(acc_);
+    return static_cast<std::size_t>(out_ - start_);
   }
 
  private:
-  std::vector<std::uint8_t>& out_;
+  std::uint8_t* out_;
+  std::uint8_t* const start_ = out_;
   std::uint64_t acc_ = 0;
   int fill_ = 0;
 };
 
 class BitReader {
  public:
-  BitReader(const std::uint8_t* data, std::size_t bytes) : data_(data), bits_(8 * std::uint64_t{bytes}) {}
+  BitReader(const std::uint8_t* data, std::size_t bytes)
+      : data_(data), bytes_(bytes), bits_(8 * std::uint64_t{bytes}) {}
 
   // bits <= 32; false when the stream ends first.
   bool get(int bits, std::uint32_t& value) {
     if (pos_ + static_cast<std::uint64_t>(bits) > bits_) return false;
-    value = peek(bits);
+    value = static_cast<std::uint32_t>(peek() & ((std::uint64_t{1} << bits) - 1));
     pos_ += static_cast<std::uint64_t>(bits);
     return true;
   }
+  // Order k, read in one look at the next bits (the code is at most kMaxCodeBits long).
   bool exp_golomb(std::uint32_t& v, int k) {
-    std::uint32_t high = 0, low = 0;
-    if (!exp_golomb(high) || (k > 0 && !get(k, low))) return false;
-    v = high << k | low;
-    return true;
-  }
-  bool exp_golomb(std::uint32_t& v) {
-    // The leading zeros counted in one look at the next bits, not one bit at a time.
-    const int ahead = static_cast<int>(std::min<std::uint64_t>(kMaxLeadingZeros + 1, bits_ - pos_));
-    const std::uint32_t window = peek(ahead);
-    if (window == 0) return false;  // more zeros than any code has, or the stream ends among them
-    const int n = __builtin_ctz(window);
-    pos_ += static_cast<std::uint64_t>(n + 1);
-    std::uint32_t low = 0;
-    if (!get(n, low)) return false;
-    v = ((1u << n) | low) - 1;
+    const std::uint64_t next = peek();
+    const std::uint64_t zeros_window = next & ((std::uint64_t{1} << (kMaxLeadingZeros + 1)) - 1);
+    if (zeros_window == 0) return false;  // more zeros than any code has, or the stream ends among them
+    const int n = __builtin_ctzll(zeros_window);
+    const int bits = 2 * n + 1 + k;
+    if (pos_ + static_cast<std::uint64_t>(bits) > bits_) return false;
+    const std::uint64_t low = (next >> (n + 1)) & ((std::uint64_t{1} << n) - 1);
+    const std::uint64_t low_k = (next >> (2 * n + 1)) & ((std::uint64_t{1} << k) - 1);
+    v = static_cast<std::uint32_t>(((std::uint64_t{1} << n | low) - 1) << k | low_k);
+    pos_ += static_cast<std::uint64_t>(bits);
     return true;
   }
   // True when what is left is the zero padding of the last byte.
@@ -98,39 +92,64 @@ class BitReader {
   }
 
  private:
-  // The next `bits` (<= 32, all within the stream) without moving past them.
-  std::uint32_t peek(int bits) const {
+  // The next 57 bits or more, zeros past the stream's end: one 8-byte read where
+  // the stream has 8 bytes left.
+  std::uint64_t peek() const {
     const std::size_t first = pos_ >> 3;
-    const std::size_t last = (pos_ + bits + 7) >> 3;  // one past the last byte touched (at most 5 bytes)
     std::uint64_t word = 0;
-    for (std::size_t b = first; b < last; ++b) word |= std::uint64_t{data_[b]} << (8 * (b - first));
-    return static_cast<std::uint32_t>((word >> (pos_ & 7)) & ((std::uint64_t{1} << bits) - 1));
+    if (first + 8 <= bytes_) {
+      for (int b = 0; b < 8; ++b) word |= std::uint64_t{data_[first + b]} << (8 * b);  // one load on x86
+    } else {
+      for (std::size_t b = first; b < bytes_; ++b) word |= std::uint64_t{data_[b]} << (8 * (b - first));
+    }
+    return word >> (pos_ & 7);
   }
 
   const std::uint8_t* data_;
+  std::size_t bytes_;
   std::uint64_t bits_;
   std::uint64_t pos_ = 0;
 };
 
-// Where ball i is expected in snapshot `tick`: its base position, carried on at
-// its velocity from prior to base when that was more than jitter.
-void predict(const DeltaReference& ref, std::uint32_t tick, std::uint32_t i, std::int32_t out[3]) {
-  const std::uint16_t* b = ref.base + 3 * std::size_t{i};
-  for (int axis = 0; axis < 3; ++axis) out[axis] = b[axis];
-  const std::int64_t ahead = std::int64_t{tick} - ref.base_tick, behind = std::int64_t{ref.base_tick} - ref.prior_tick;
-  if (!ref.prior || i >= ref.prior_count || ahead <= 0 || behind <= 0) return;
-  const std::uint16_t* a = ref.prior + 3 * std::size_t{i};
-  std::int64_t moved[3];
-  bool moving = false;
-  for (int axis = 0; axis < 3; ++axis) {
-    moved[axis] = std::int64_t{b[axis]} - a[axis];
-    moving = moving || moved[axis] >= kMovingQuanta || moved[axis] <= -kMovingQuanta;
+// The longest code of a residual: 17 leading zeros, a one, 17 bits, the order's 7.
+constexpr int kMaxCodeBits = 2 * kMaxLeadingZeros + 1 + kMaxGolombOrder;
+static_assert(kMaxCodeBits <= 56, "a code is put and read in one 64-bit word");
+
+// Where each ball is expected in snapshot `tick`: its base position, carried on
+// at its velocity from prior to base when that was more than jitter.
+class Predictor {
+ public:
+  Predictor(const DeltaReference& ref, std::uint32_t tick)
+      : ref_(ref),
+        ahead_(std::int64_t{tick} - ref.base_tick),
+        behind_(std::int64_t{ref.base_tick} - ref.prior_tick),
+        carries_(ref.prior && ahead_ > 0 && behind_ > 0) {}
+
+  void operator()(std::uint32_t i, std::int32_t out[3]) const {
+    const std::uint16_t* b = ref_.base + 3 * std::size_t{i};
+    for (int axis = 0; axis < 3; ++axis) out[axis] = b[axis];
+    if (!carries_ || i >= ref_.prior_count) return;
+    const std::uint16_t* a = ref_.prior + 3 * std::size_t{i};
+    std::int64_t moved[3];
+    bool moving = false;
+    for (int axis = 0; axis < 3; ++axis) {
+      moved[axis] = std::int64_t{b[axis]} - a[axis];
+      moving = moving || moved[axis] >= kMovingQuanta || moved[axis] <= -kMovingQuanta;
+    }
+    if (!moving) return;
+    // Integer arithmetic, truncating, so that server and client predict the same
+    // value; snapshots a tick apart (the usual case) need no divide.
+    for (int axis = 0; axis < 3; ++axis) {
+      const std::int64_t carried = behind_ == 1 ? moved[axis] * ahead_ : moved[axis] * ahead_ / behind_;
+      out[axis] = static_cast<std::int32_t>(std::clamp<std::int64_t>(b[axis] + carried, 0, 65535));
+    }
   }
-  if (!moving) return;
-  // Integer arithmetic, truncating, so that server and client predict the same value.
-  for (int axis = 0; axis < 3; ++axis)
-    out[axis] = static_cast<std::int32_t>(std::clamp<std::int64_t>(b[axis] + moved[axis] * ahead / behind, 0, 65535));
-}
+
+ private:
+  const DeltaReference& ref_;
+  const std::int64_t ahead_, behind_;
+  const bool carries_;
+};
 
 }  // namespace
 
@@ -138,8 +157,13 @@ void encode_positions_delta(const DeltaReference& ref, std::uint32_t tick, const
                             std::uint32_t count, PositionsDelta& out) {
   const std::uint32_t common = std::min(ref.base_count, count);
   out.unchanged.assign(unchanged_mask_bytes(ref.base_count, count), 0);
-  out.changes.clear();
-  out.residuals.clear();
+  // Never shrunk, so that reusing `out` writes without clearing.
+  if (out.residuals.size() < 3 * std::size_t{common}) out.residuals.resize(3 * std::size_t{common});
+  std::uint32_t* residual = out.residuals.data();
+  // Histograms of the residuals' lengths, for the order below: one per axis, so
+  // that equal lengths in a row do not wait on each other's increment.
+  std::uint64_t lengths[3][kMaxLeadingZeros + 1] = {};
+  const Predictor predict(ref, tick);
   for (std::uint32_t i = 0; i < common; ++i) {
     const std::uint16_t* b = ref.base + 3 * std::size_t{i};
     const std::uint16_t* p = now + 3 * std::size_t{i};
@@ -148,30 +172,38 @@ void encode_positions_delta(const DeltaReference& ref, std::uint32_t tick, const
       continue;
     }
     std::int32_t expected[3];
-    predict(ref, tick, i, expected);
-    for (int axis = 0; axis < 3; ++axis) out.residuals.push_back(zigzag(std::int32_t{p[axis]} - expected[axis]));
+    predict(i, expected);
+    for (int axis = 0; axis < 3; ++axis) {
+      const std::uint32_t z = zigzag(std::int32_t{p[axis]} - expected[axis]);
+      *residual++ = z;
+      ++lengths[axis][floor_log2(z + 1)];
+    }
   }
-  // The order that codes this snapshot's differences in about the fewest bits, from
-  // a histogram of their lengths: a code of order k for a value of L significant
-  // bits takes about 2 max(L - k, 0) + 1 + k bits.
-  std::uint64_t lengths[kMaxLeadingZeros + 1] = {};
-  for (const std::uint32_t z : out.residuals) ++lengths[floor_log2(z + 1)];
+  const std::uint32_t* const residuals_end = residual;
+  // The order that codes this snapshot's differences in about the fewest bits: a
+  // code of order k for a value of L significant bits takes about 2 max(L - k, 0) + 1 + k bits.
   std::uint64_t best_bits = UINT64_MAX;
   int order = 0;
   for (int k = 0; k <= kMaxGolombOrder; ++k) {
     std::uint64_t bits = 0;
     for (int length = 0; length <= kMaxLeadingZeros; ++length)
-      bits += lengths[length] * static_cast<std::uint64_t>(2 * std::max(length - k, 0) + 1 + k);
+      bits += (lengths[0][length] + lengths[1][length] + lengths[2][length]) *
+              static_cast<std::uint64_t>(2 * std::max(length - k, 0) + 1 + k);
     if (bits < best_bits) {
       best_bits = bits;
       order = k;
     }
   }
-  BitWriter changes(out.changes);
+  const std::size_t residual_count = static_cast<std::size_t>(residuals_end - out.residuals.data());
+  const std::size_t new_values = 3 * (std::size_t{count} - common);
+  // Room for the stream, which BitWriter does not check: a code is at most 2 bits
+  // longer than the estimate above, and each store writes 8 bytes.
+  out.changes.resize((kOrderBits + best_bits + 2 * residual_count + 16 * new_values) / 8 + 8);
+  BitWriter changes(out.changes.data());
   changes.put(static_cast<std::uint32_t>(order), kOrderBits);
-  for (const std::uint32_t z : out.residuals) changes.exp_golomb(z, order);
+  for (const std::uint32_t* z = out.residuals.data(); z != residuals_end; ++z) changes.exp_golomb(*z, order);
   for (std::size_t v = 3 * std::size_t{common}; v < 3 * std::size_t{count}; ++v) changes.put(now[v], 16);
-  changes.flush();
+  out.changes.resize(changes.flush());
 }
 
 std::string decode_positions_delta(const DeltaReference& ref, std::uint32_t tick, const std::uint8_t* unchanged,
@@ -184,6 +216,7 @@ std::string decode_positions_delta(const DeltaReference& ref, std::uint32_t tick
   BitReader reader(changes, changes_bytes);
   std::uint32_t order = 0;
   if (!reader.get(kOrderBits, order)) return "the changes stream is empty";
+  const Predictor predict(ref, tick);
   for (std::uint32_t i = 0; i < common; ++i) {
     const std::uint16_t* b = ref.base + 3 * std::size_t{i};
     std::uint16_t* p = out + 3 * std::size_t{i};
@@ -192,7 +225,7 @@ std::string decode_positions_delta(const DeltaReference& ref, std::uint32_t tick
       continue;
     }
     std::int32_t expected[3];
-    predict(ref, tick, i, expected);
+    predict(i, expected);
     for (int axis = 0; axis < 3; ++axis) {
       std::uint32_t z = 0;
       if (!reader.exp_golomb(z, static_cast<int>(order)))
