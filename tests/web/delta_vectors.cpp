@@ -81,6 +81,11 @@ int main() {
   for (std::uint32_t b = 0; b < n; b += 7) jumped[3 * b + 1] = static_cast<std::uint16_t>(any(rng));
   emit("jumps (a high exp-Golomb order)", {}, 0, base, 10, jumped, 11);
 
+  // A few far jumps among jitter: order 0, so each jump's code is longer than 32 bits.
+  Values far(jittered);
+  for (std::uint32_t b = 0; b < n; b += 97) far[3 * b + 2] = static_cast<std::uint16_t>(base[3 * b + 2] ^ 0xc000);
+  emit("far jumps among jitter (codes over 32 bits)", {}, 0, base, 10, far, 11);
+
   // Predicted from prior (tick 9) to base (tick 10), three ticks ahead, with a small change of velocity.
   Values moving = steady(prior, 4);
   for (auto& q : moving) q = clamp16(q + jitter(rng));
