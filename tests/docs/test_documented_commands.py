@@ -42,6 +42,7 @@ EXCLUDED = {
     "--benchmark_enable_random_interleaving=true": "as fishtank-bench-variants",
     "build/server/fishtank-bench-variants --benchmark_filter=step_wide --benchmark_repetitions=6 "
     "--benchmark_enable_random_interleaving=true": "as fishtank-bench-variants",
+    "build/server/fishtank-bench-delta": "runs a 100 000-ball wide scene and settles a tank for its snapshots, half a minute",
     "build/server/fishtank-accuracy": "the accuracy sweeps, minutes (scripts/figures runs them)",
     "scripts/callgrind-step": "valgrind over every variant, minutes",
     "scripts/figures": "installs gnuplot, sweeps for minutes and rewrites docs/figures/",
