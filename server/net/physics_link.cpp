@@ -144,12 +144,12 @@ void PhysicsLink::leave(World& world, std::uint32_t client) {
 
 void PhysicsLink::refresh_figures(const World& world, Clock::time_point now) {
   if (now < next_figures_ && figures_start_ == scene_.start_count()) return;
-  next_figures_ = now + kFiguresPeriod;
   figures_start_ = scene_.start_count();
   kinetic_energy_per_ball_ = world.ball_count() ? static_cast<float>(kinetic_energy(world) / world.ball_count()) : 0.0f;
   const ContactFigures contact = contact_figures(world);
   contacts_ = contact.contacts;
   max_overlap_ = contact.max_overlap;
+  next_figures_ = now + std::max<Clock::duration>(kFiguresPeriod, kFiguresSpacing * (Clock::now() - now));
 }
 
 void PhysicsLink::publish_snapshot(const World& world, const LoopStatus& status) {

@@ -57,9 +57,13 @@ class PhysicsLink {
   void publish_snapshot(const World& world, const LoopStatus& status);
   // Refreshes the plotted figures (energy, contacts) when they are older than kFiguresPeriod.
   void refresh_figures(const World& world, Clock::time_point now);
-  // The figures pass over every ball and contact: ten times a second is
-  // plenty for a plot, and keeps a large scene's snapshots cheap.
+  // The figures pass over every ball and contact on the physics thread while
+  // the workers wait: ten times a second is plenty for a plot. A pass that
+  // takes longer than a kFiguresSpacing-th of that (a million balls take
+  // about a step's time) waits kFiguresSpacing times its cost instead, so
+  // watching a large scene does not slow its physics by more than that share.
   static constexpr std::chrono::milliseconds kFiguresPeriod{100};
+  static constexpr int kFiguresSpacing = 20;
   // A restart costs what filling its scene costs; the next may come only
   // after this many times that, so however often clients ask, restarts take
   // at most a fifth of the physics thread.
