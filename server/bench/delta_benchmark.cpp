@@ -9,7 +9,7 @@
 // The server codes a frame per acknowledged base on its io thread; the GLFW
 // viewer decodes every one. --write-wide DIR writes the wide case's base,
 // prior, snapshot and delta as raw little-endian files and exits, so that
-// scripts/figures-delta-coder can time the page's twin (web/src/delta.ts) on them.
+// scripts/figures-watching can time the page's twin (web/src/delta.ts) on them.
 
 #include <benchmark/benchmark.h>
 
