@@ -59,9 +59,9 @@ class PhysicsLink {
   void refresh_figures(const World& world, Clock::time_point now);
   // The figures pass over every ball and contact on the physics thread while
   // the workers wait: ten times a second is plenty for a plot. A pass that
-  // takes longer than a kFiguresSpacing-th of that (a million balls take
-  // about a step's time) waits kFiguresSpacing times its cost instead, so
-  // watching a large scene does not slow its physics by more than that share.
+  // takes longer than a kFiguresSpacing-th of that waits kFiguresSpacing
+  // times its cost instead, so watching a huge scene slows its physics by at
+  // most that share.
   static constexpr std::chrono::milliseconds kFiguresPeriod{100};
   static constexpr int kFiguresSpacing = 20;
   // A restart costs what filling its scene costs; the next may come only
