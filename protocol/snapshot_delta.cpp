@@ -20,19 +20,21 @@ std::int32_t unzigzag(std::uint32_t z) { return static_cast<std::int32_t>(z >> 1
 
 int floor_log2(std::uint32_t v) { return 31 - __builtin_clz(v); }
 
-// Writes into a buffer sized beforehand for the longest stream the codes can
-// make, 8 bytes at every code and no branch: growing a vector per word was the
+// Writes 8 bytes at every code into a vector sized beforehand for the stream
+// expected, growing it only should that be short: growing it per word was the
 // coder's main cost, and a branch per word its next.
 class BitWriter {
  public:
-  explicit BitWriter(std::uint8_t* out) : out_(out) {}
+  BitWriter(std::vector<std::uint8_t>& out, std::size_t expected_bytes) : out_(out) { out_.resize(expected_bytes + 8); }
 
   // bits <= 56: with at most 7 bits pending, the 64-bit accumulator holds them all.
   void put(std::uint64_t value, int bits) {
+    if (size_ + 8 > out_.size()) out_.resize(2 * out_.size());
     acc_ |= value << fill_;
     fill_ += bits;
-    for (int b = 0; b < 8; ++b) out_[b] = static_cast<std::uint8_t>(acc_ >> (8 * b));  // one store on x86
-    out_ += fill_ >> 3;
+    std::uint8_t* at = out_.data() + size_;
+    for (int b = 0; b < 8; ++b) at[b] = static_cast<std::uint8_t>(acc_ >> (8 * b));  // one store on x86
+    size_ += static_cast<std::size_t>(fill_ >> 3);
     acc_ >>= fill_ & ~7;
     fill_ &= 7;
   }
@@ -45,15 +47,15 @@ class BitWriter {
     const std::uint64_t low = y ^ (std::uint64_t{1} << n);
     put((low << 1 | 1) << n | low_k << (2 * n + 1), 2 * n + 1 + k);
   }
-  // The bytes written, the last padded with zeros.
-  std::size_t flush() {
-    if (fill_ > 0) *out_++ = static_cast<std::uint8_t>(acc_);
-    return static_cast<std::size_t>(out_ - start_);
+  // Pads the last byte with zeros and trims the vector to the stream.
+  void flush() {
+    if (fill_ > 0) out_[size_++] = static_cast<std::uint8_t>(acc_);
+    out_.resize(size_);
   }
 
  private:
-  std::uint8_t* out_;
-  std::uint8_t* const start_ = out_;
+  std::vector<std::uint8_t>& out_;
+  std::size_t size_ = 0;
   std::uint64_t acc_ = 0;
   int fill_ = 0;
 };
@@ -196,14 +198,12 @@ void encode_positions_delta(const DeltaReference& ref, std::uint32_t tick, const
   }
   const std::size_t residual_count = static_cast<std::size_t>(residuals_end - out.residuals.data());
   const std::size_t new_values = 3 * (std::size_t{count} - common);
-  // Room for the stream, which BitWriter does not check: a code is at most 2 bits
-  // longer than the estimate above, and each store writes 8 bytes.
-  out.changes.resize((kOrderBits + best_bits + 2 * residual_count + 16 * new_values) / 8 + 8);
-  BitWriter changes(out.changes.data());
+  // A code is at most 2 bits longer than the estimate above.
+  BitWriter changes(out.changes, (kOrderBits + best_bits + 2 * residual_count + 16 * new_values) / 8);
   changes.put(static_cast<std::uint32_t>(order), kOrderBits);
   for (const std::uint32_t* z = out.residuals.data(); z != residuals_end; ++z) changes.exp_golomb(*z, order);
   for (std::size_t v = 3 * std::size_t{common}; v < 3 * std::size_t{count}; ++v) changes.put(now[v], 16);
-  out.changes.resize(changes.flush());
+  changes.flush();
 }
 
 std::string decode_positions_delta(const DeltaReference& ref, std::uint32_t tick, const std::uint8_t* unchanged,
