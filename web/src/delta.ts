@@ -27,39 +27,33 @@ class BitReader {
     this.bits = 8 * data.length;
   }
 
-  // The next 32 bits, zeros past the stream's end (a Uint8Array reads undefined there, which | makes 0).
-  private peek(): number {
+  // The 32 bits from bit `at`, zeros past the stream's end (a Uint8Array reads undefined there, which | makes 0).
+  private peek(at: number): number {
     const d = this.data;
-    const first = this.pos >>> 3;
-    const shift = this.pos & 7;
+    const first = at >>> 3;
+    const shift = at & 7;
     const low = (d[first] | (d[first + 1] << 8) | (d[first + 2] << 16) | (d[first + 3] << 24)) >>> shift;
     return shift === 0 ? low >>> 0 : (low | (d[first + 4] << (32 - shift))) >>> 0;
   }
 
-  // n <= 32 bits, or null when the stream ends first.
+  // n < 32 bits, or null when the stream ends first.
   get(n: number): number | null {
     if (this.pos + n > this.bits) return null;
-    const v = n === 32 ? this.peek() : this.peek() & ((1 << n) - 1);
+    const v = this.peek(this.pos) & ((1 << n) - 1);
     this.pos += n;
-    return v >>> 0;
+    return v;
   }
 
   // Order k: n zeros, a one, the n bits of (v >> k) + 1 below its leading one, then the k low bits of v.
   golomb(k: number): number | null {
-    const window = this.peek();
+    const window = this.peek(this.pos);
     const zeros = window & ((1 << (MAX_LEADING_ZEROS + 1)) - 1);
     if (zeros === 0) return null;  // more zeros than any code has, or the stream ends among them
     const n = 31 - Math.clz32(zeros & -zeros);
-    if (this.pos + 2 * n + 1 + k > this.bits) return null;
-    let rest: number;
-    if (2 * n + 1 + k <= 32) {
-      rest = window >>> (n + 1);
-    } else {
-      this.pos += n + 1;
-      rest = this.peek();
-      this.pos -= n + 1;
-    }
-    this.pos += 2 * n + 1 + k;
+    const length = 2 * n + 1 + k;
+    if (this.pos + length > this.bits) return null;
+    const rest = length <= 32 ? window >>> (n + 1) : this.peek(this.pos + n + 1);
+    this.pos += length;
     const low = rest & ((1 << n) - 1);
     const lowK = (rest >>> n) & ((1 << k) - 1);
     return ((((1 << n) | low) - 1) << k) | lowK;
