@@ -12,6 +12,9 @@ constexpr int kMaxLeadingZeros = 17;
 // The stream starts with the exp-Golomb order, in kOrderBits bits.
 constexpr int kOrderBits = 3;
 constexpr int kMaxGolombOrder = (1 << kOrderBits) - 1;
+// The longest code of a residual: 17 leading zeros, a one, 17 bits, the order's 7.
+constexpr int kMaxCodeBits = 2 * kMaxLeadingZeros + 1 + kMaxGolombOrder;
+static_assert(kMaxCodeBits <= 56, "a code is put and read in one 64-bit word");
 
 std::uint32_t zigzag(std::int32_t d) {
   return (static_cast<std::uint32_t>(d) << 1) ^ static_cast<std::uint32_t>(d >> 31);
@@ -20,9 +23,9 @@ std::int32_t unzigzag(std::uint32_t z) { return static_cast<std::int32_t>(z >> 1
 
 int floor_log2(std::uint32_t v) { return 31 - __builtin_clz(v); }
 
-// Writes 8 bytes at every code into a vector sized beforehand for the stream
-// expected, growing it only should that be short: growing it per word was the
-// coder's main cost, and a branch per word its next.
+// Writes each code whole, as one 8-byte store into a vector sized beforehand
+// for the stream expected (grown only should that be short): growing the
+// vector word by word was the coder's main cost.
 class BitWriter {
  public:
   BitWriter(std::vector<std::uint8_t>& out, std::size_t expected_bytes) : out_(out) { out_.resize(expected_bytes + 8); }
@@ -62,12 +65,11 @@ class BitWriter {
 
 class BitReader {
  public:
-  BitReader(const std::uint8_t* data, std::size_t bytes)
-      : data_(data), bytes_(bytes), bits_(8 * std::uint64_t{bytes}) {}
+  BitReader(const std::uint8_t* data, std::size_t bytes) : data_(data), bytes_(bytes) {}
 
   // bits <= 32; false when the stream ends first.
   bool get(int bits, std::uint32_t& value) {
-    if (pos_ + static_cast<std::uint64_t>(bits) > bits_) return false;
+    if (pos_ + static_cast<std::uint64_t>(bits) > stream_bits()) return false;
     value = static_cast<std::uint32_t>(peek() & ((std::uint64_t{1} << bits) - 1));
     pos_ += static_cast<std::uint64_t>(bits);
     return true;
@@ -79,7 +81,7 @@ class BitReader {
     if (zeros_window == 0) return false;  // more zeros than any code has, or the stream ends among them
     const int n = __builtin_ctzll(zeros_window);
     const int bits = 2 * n + 1 + k;
-    if (pos_ + static_cast<std::uint64_t>(bits) > bits_) return false;
+    if (pos_ + static_cast<std::uint64_t>(bits) > stream_bits()) return false;
     const std::uint64_t low = (next >> (n + 1)) & ((std::uint64_t{1} << n) - 1);
     const std::uint64_t low_k = (next >> (2 * n + 1)) & ((std::uint64_t{1} << k) - 1);
     v = static_cast<std::uint32_t>(((std::uint64_t{1} << n | low) - 1) << k | low_k);
@@ -89,7 +91,7 @@ class BitReader {
   // True when what is left is the zero padding of the last byte.
   bool only_padding_left() {
     std::uint32_t rest = 0;
-    const int left = static_cast<int>(bits_ - pos_);
+    const int left = static_cast<int>(stream_bits() - pos_);
     return left < 8 && get(left, rest) && rest == 0;
   }
 
@@ -107,15 +109,12 @@ class BitReader {
     return word >> (pos_ & 7);
   }
 
+  std::uint64_t stream_bits() const { return 8 * std::uint64_t{bytes_}; }
+
   const std::uint8_t* data_;
   std::size_t bytes_;
-  std::uint64_t bits_;
   std::uint64_t pos_ = 0;
 };
-
-// The longest code of a residual: 17 leading zeros, a one, 17 bits, the order's 7.
-constexpr int kMaxCodeBits = 2 * kMaxLeadingZeros + 1 + kMaxGolombOrder;
-static_assert(kMaxCodeBits <= 56, "a code is put and read in one 64-bit word");
 
 // Where each ball is expected in snapshot `tick`: its base position, carried on
 // at its velocity from prior to base when that was more than jitter.
