@@ -23,28 +23,22 @@
 #include <vector>
 
 #include "common/fp_env.h"
-#include "protocol/quantize.h"
 #include "protocol/snapshot_delta.h"
 #include "server/bench/scenes.h"
+#include "server/net/snapshot_encoder.h"
 #include "server/physics/world.h"
 
 namespace {
 
 using fishtank::World;
 
+// The snapshots' ticks: each coded against the one before, with the one before that as its prior.
+constexpr std::uint32_t kPriorTick = 1, kBaseTick = 2, kNowTick = 3;
+
 struct Sequence {
   std::uint32_t balls = 0;
   std::vector<std::uint16_t> prior, base, now;  // 3 quantised values per ball, in id order
 };
-
-std::vector<std::uint16_t> quantised(const World& world) {
-  std::vector<std::uint16_t> out(3 * std::size_t{world.ball_count()});
-  for (std::uint32_t id = 0; id < world.ball_count(); ++id) {
-    const fishtank::Float4& p = world.ball(id).pos;
-    fishtank::protocol::quantize_position({p.x, p.y, p.z}, world.params().tank, &out[3 * std::size_t{id}]);
-  }
-  return out;
-}
 
 // Three snapshots of the scene a sixtieth of a simulated second apart, from `from_seconds` on
 // (0: once settled).
@@ -57,18 +51,22 @@ Sequence snapshots(const char* scene, std::uint32_t balls, double from_seconds) 
   params.tank = fishtank::scene_tank(spec);
   World world(params, fishtank::kSseKernels, fishtank::WorkerPool::hardware_threads(), 1);
   fishtank::populate(world, spec);
-  fishtank::TunedStepper untuned(world, false);
   if (from_seconds > 0.0) {
     while (world.time() < from_seconds) world.step();
   } else {
+    fishtank::TunedStepper untuned(world, false);
     fishtank::settle(untuned, spec);
   }
   const int steps_apart = static_cast<int>(std::lround(1.0 / 60.0 / world.dt()));
+  // Captured as the server captures them.
+  fishtank::net::SnapshotEncoder capture;
+  fishtank::protocol::SnapshotHeader header;
+  header.tank = world.params().tank;
   Sequence s;
   s.balls = world.ball_count();
   for (std::vector<std::uint16_t>* snapshot : {&s.prior, &s.base, &s.now}) {
     for (int i = 0; i < steps_apart; ++i) world.step();
-    *snapshot = quantised(world);
+    *snapshot = capture.encode(world, header)->quantised;
   }
   return s;
 }
@@ -85,7 +83,11 @@ const Sequence& sequence(Scene scene) {
 }
 
 fishtank::protocol::DeltaReference reference(const Sequence& s) {
-  return {s.base.data(), s.balls, 2, s.prior.data(), s.balls, 1};
+  return {s.base.data(), s.balls, kBaseTick, s.prior.data(), s.balls, kPriorTick};
+}
+
+void code(const Sequence& s, fishtank::protocol::PositionsDelta& delta) {
+  fishtank::protocol::encode_positions_delta(reference(s), kNowTick, s.now.data(), s.balls, delta);
 }
 
 void report(benchmark::State& state, const Sequence& s, std::size_t bytes) {
@@ -99,7 +101,7 @@ void delta_encode(benchmark::State& state, Scene scene) {
   const Sequence& s = sequence(scene);
   fishtank::protocol::PositionsDelta delta;
   for (auto _ : state) {
-    fishtank::protocol::encode_positions_delta(reference(s), 3, s.now.data(), s.balls, delta);
+    code(s, delta);
     benchmark::DoNotOptimize(delta.changes.data());
   }
   report(state, s, delta.unchanged.size() + delta.changes.size());
@@ -108,23 +110,23 @@ void delta_encode(benchmark::State& state, Scene scene) {
 void delta_decode(benchmark::State& state, Scene scene) {
   const Sequence& s = sequence(scene);
   fishtank::protocol::PositionsDelta delta;
-  fishtank::protocol::encode_positions_delta(reference(s), 3, s.now.data(), s.balls, delta);
+  code(s, delta);
   std::vector<std::uint16_t> out(s.now.size());
   for (auto _ : state) {
-    const std::string why =
-        fishtank::protocol::decode_positions_delta(reference(s), 3, delta.unchanged.data(), delta.unchanged.size(),
-                                                   delta.changes.data(), delta.changes.size(), s.balls, out.data());
+    const std::string why = fishtank::protocol::decode_positions_delta(reference(s), kNowTick, delta.unchanged.data(),
+                                                                       delta.unchanged.size(), delta.changes.data(),
+                                                                       delta.changes.size(), s.balls, out.data());
     if (!why.empty() || out != s.now) throw std::runtime_error("the delta did not decode to its snapshot: " + why);
   }
   report(state, s, delta.unchanged.size() + delta.changes.size());
 }
 
 // The wide case's files for the page's decoder: prior.u16, base.u16, now.u16 (3 values per ball),
-// unchanged.u8 and changes.u8, coded as delta_encode codes them.
+// unchanged.u8 and changes.u8, coded as delta_encode codes them (ticks kPriorTick, kBaseTick, kNowTick).
 int write_wide(const std::string& dir) {
   const Sequence& s = sequence(Scene::wide);
   fishtank::protocol::PositionsDelta delta;
-  fishtank::protocol::encode_positions_delta(reference(s), 3, s.now.data(), s.balls, delta);
+  code(s, delta);
   auto write = [&dir](const char* name, const void* data, std::size_t bytes) {
     std::ofstream out(dir + "/" + name, std::ios::binary);
     out.write(static_cast<const char*>(data), static_cast<std::streamsize>(bytes));
