@@ -20,25 +20,8 @@ rm -f "$png"
 
 start_server "$log" --balls 1000
 
-# Wait until every ball has been poured in and has had 4 s of server time to
-# fall (the server's status lines give both), so the pile lies below the
-# player sphere at the tank's centre and no falling ball hides it.
-settled=""
-for _ in $(seq 1200); do
-  poured=$(sed -n 's/^t = *\([0-9.]*\) s *balls *[0-9]* (+0 queued).*/\1/p' "$log" | head -n 1)
-  latest=$(sed -n 's/^t = *\([0-9.]*\) s.*/\1/p' "$log" | tail -n 1)
-  if [ -n "$poured" ] && awk -v p="$poured" -v t="$latest" 'BEGIN { exit !(t >= p + 4) }'; then
-    settled=1
-    break
-  fi
-  kill -0 "$server_pid" 2>/dev/null || break
-  sleep 0.1
-done
-if [ -z "$settled" ]; then
-  echo "the server did not finish pouring its balls within 120 s:"
-  cat "$log"
-  exit 1
-fi
+# The pile lies below the player sphere at the tank's centre and no falling ball hides it.
+wait_settled "$log"
 
 timeout 150 xvfb-run -a -s "-screen 0 1280x1024x24" \
   "$viewer" --connect "127.0.0.1:$port" --no-hud --screenshot "$png" --frames 60

@@ -1,6 +1,7 @@
 # Sourced by the viewer's Xvfb tests: start_server LOG ARGS... starts
 # fishtank-server ($server) on a free loopback port with ARGS, its stderr in
 # LOG, stops it when the test exits, and sets $port (exit 1 when it does not listen).
+# wait_settled LOG waits until every ball is poured and has had 4 s to fall.
 # scripts/fishtank_tools.py reads the port, as it does for every script.
 tools="$(dirname "${BASH_SOURCE[0]}")/../../scripts/fishtank_tools.py"
 start_server() {
@@ -14,6 +15,24 @@ start_server() {
     return 0
   fi
   echo "the server did not report its port:"
+  cat "$log"
+  exit 1
+}
+
+# The server's status lines give both the time the last ball was poured and the
+# latest time, so the pile has formed when the one is 4 s past the other.
+wait_settled() {
+  local log=$1 poured latest
+  for _ in $(seq 1200); do
+    poured=$(sed -n 's/^t = *\([0-9.]*\) s *balls *[0-9]* (+0 queued).*/\1/p' "$log" | head -n 1)
+    latest=$(sed -n 's/^t = *\([0-9.]*\) s.*/\1/p' "$log" | tail -n 1)
+    if [ -n "$poured" ] && awk -v p="$poured" -v t="$latest" 'BEGIN { exit !(t >= p + 4) }'; then
+      return 0
+    fi
+    kill -0 "$server_pid" 2>/dev/null || break
+    sleep 0.1
+  done
+  echo "the server did not finish pouring its balls within 120 s:"
   cat "$log"
   exit 1
 }
