@@ -39,6 +39,7 @@ constexpr float kPlayerSpeed = 8.0f;  // m/s; the server clamps at its own maxim
 constexpr std::uint32_t kBallsPerPress = 1000;
 constexpr float kOutlineGrow = 1.35f;
 const std::array<std::uint8_t, 4> kOutlineRgba{255, 176, 32, 255};
+constexpr float kHiddenAlpha = 0.8f;  // the own sphere's amber over the balls in front of it
 
 struct GlfwSession {
   GlfwSession() { ok = glfwInit() == GLFW_TRUE; }
@@ -279,9 +280,10 @@ int run_viewer(const ViewerOptions& opt) {
       const Mat4 view_proj = camera.view_projection(height > 0 ? static_cast<float>(width) / height : 1.0f);
       spheres.draw(view_proj, instances);
       if (own >= 0) {
-        SphereInstance ring = instances[static_cast<std::size_t>(own)];
-        ring.rgba = kOutlineRgba;
-        spheres.draw_outline(view_proj, ring, kOutlineGrow);
+        SphereInstance mine = instances[static_cast<std::size_t>(own)];
+        mine.rgba = kOutlineRgba;
+        spheres.draw_outline(view_proj, mine, kOutlineGrow);
+        spheres.draw_hidden(view_proj, mine, kHiddenAlpha);
       }
       if (show_tank) tank_outline.draw(view_proj);
       hud.render();

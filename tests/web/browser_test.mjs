@@ -112,6 +112,23 @@ test('B pours 1000 balls in: the server\'s count rises and the HUD shows it', as
   assert.ok(shown >= before + 1000, `the HUD shows ${shown} balls, ${before} + 1000 at least expected`);
 });
 
+test('pressed under the pile (Q), the page\'s own sphere shows through the balls in amber', async () => {
+  await page.keyboard.down('KeyQ');
+  await waitForState(page, (st) => own(st).pos[1] < 1.5, 'the player on the floor');
+  await page.keyboard.up('KeyQ');
+  await waitForState(page, (st) => st.ownPlayerDrawn[1] < 1.5, 'the player drawn on the floor');
+  await page.keyboard.press('F1');
+  let c;
+  for (let tries = 0; tries < 10 && !(c?.white < 20 && c?.amber >= 20); ++tries) {
+    await sleep(300);
+    c = await countColours(page, await page.screenshot({ type: 'png' }));
+  }
+  await page.keyboard.press('F1');
+  const summary = JSON.stringify(c);
+  assert.ok(c.white < 20, `no white sphere in view, the pile hides the player: ${summary}`);
+  assert.ok(c.amber >= 20, `its amber shows through the balls: ${summary}`);
+});
+
 test('holding D moves the player sphere to the camera\'s right (+x at the start)', async () => {
   const start = own(await waitForState(page, (st) => own(st), 'the own player'));
   await page.keyboard.down('KeyD');

@@ -109,13 +109,14 @@ export async function countColours(page, png) {
     const ctx = c.getContext('2d');
     ctx.drawImage(img, 0, 0);
     const d = ctx.getImageData(0, 0, c.width, c.height).data;
-    const n = { red: 0, green: 0, blue: 0, white: 0, background: 0, total: c.width * c.height };
+    const n = { red: 0, green: 0, blue: 0, white: 0, amber: 0, background: 0, total: c.width * c.height };
     const [br, bg, bb] = [d[0], d[1], d[2]];  // the corner: the clear colour
     for (let i = 0; i < d.length; i += 4) {
       const r = d[i], g = d[i + 1], b = d[i + 2];
       const lo = Math.min(r, g, b), hi = Math.max(r, g, b);
       if (Math.abs(r - br) <= 6 && Math.abs(g - bg) <= 6 && Math.abs(b - bb) <= 6) ++n.background;
       else if (lo >= 170 && hi - lo <= 30) ++n.white;
+      else if (r >= 150 && r > g && g >= 0.4 * r && b <= 0.65 * g) ++n.amber;  // the own sphere's ring
       else if (r >= 80 && r > 2 * g && r > 2 * b) ++n.red;
       else if (g >= 80 && g > 2 * r && g > 2 * b) ++n.green;
       else if (b >= 80 && b > 2 * r && b > 1.5 * g) ++n.blue;

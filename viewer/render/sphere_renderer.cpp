@@ -127,4 +127,23 @@ void SphereRenderer::draw_outline(const Mat4& view_proj, const SphereInstance& s
   glBindVertexArray(0);
 }
 
+void SphereRenderer::draw_hidden(const Mat4& view_proj, const SphereInstance& sphere, float alpha) {
+  glUseProgram(program_);
+  glUniformMatrix4fv(u_view_proj_, 1, GL_FALSE, view_proj.data());
+  glUniform1f(u_grow_, 1.0f);
+  glUniform1i(u_unlit_, GL_TRUE);
+  glBindVertexArray(vao_);
+  upload(&sphere, 1);
+  glDepthFunc(GL_GREATER);
+  glDepthMask(GL_FALSE);
+  glEnable(GL_BLEND);
+  glBlendColor(0.0f, 0.0f, 0.0f, alpha);
+  glBlendFunc(GL_CONSTANT_ALPHA, GL_ONE_MINUS_CONSTANT_ALPHA);
+  glDrawElementsInstanced(GL_TRIANGLES, index_count_, GL_UNSIGNED_SHORT, nullptr, 1);
+  glDisable(GL_BLEND);
+  glDepthMask(GL_TRUE);
+  glDepthFunc(GL_LESS);
+  glBindVertexArray(0);
+}
+
 }  // namespace fishtank::viewer

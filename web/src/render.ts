@@ -1,6 +1,6 @@
 // WebGL2 drawing: instanced spheres (a 12x12 UV mesh with smooth per-vertex
 // normals), the tank's edges, white player spheres and an amber ring around
-// this page's own.
+// this page's own, which shows through the balls that hide it.
 //
 // The balls' per-instance attributes are the snapshot's own arrays, uploaded
 // as they arrive: the quantised uint16 positions of the two snapshots a frame
@@ -20,6 +20,7 @@ const MAX_KINDS = 16;  // the shader's table; Welcome lists 3
 const PLAYER_RADIUS = 0.5;  // kPlayerDiameter / 2 (common/tank.h)
 const OUTLINE_GROW = 1.35;
 const OUTLINE_COLOUR: Vec3 = [1.0, 0.72, 0.1];
+const HIDDEN_ALPHA = 0.8;  // the own sphere's amber over the balls in front of it
 const CLEAR: [number, number, number] = [0.055, 0.066, 0.09];
 
 // One fixed light from above and in front of the default camera, plus ambient so
@@ -245,6 +246,18 @@ export class Renderer {
         gl.cullFace(gl.FRONT);
         gl.drawElementsInstanced(gl.TRIANGLES, this.indexCount, gl.UNSIGNED_SHORT, 0, 1);
         gl.cullFace(gl.BACK);
+        // Where balls hide it (the sphere starts amid the pour), the sphere again, amber and
+        // blended over them: only the depth test's GREATER passes, so the visible part stays white.
+        gl.uniform1f(this.playerU.u_radius, PLAYER_RADIUS);
+        gl.depthFunc(gl.GREATER);
+        gl.depthMask(false);
+        gl.enable(gl.BLEND);
+        gl.blendColor(0, 0, 0, HIDDEN_ALPHA);
+        gl.blendFunc(gl.CONSTANT_ALPHA, gl.ONE_MINUS_CONSTANT_ALPHA);
+        gl.drawElementsInstanced(gl.TRIANGLES, this.indexCount, gl.UNSIGNED_SHORT, 0, 1);
+        gl.disable(gl.BLEND);
+        gl.depthMask(true);
+        gl.depthFunc(gl.LESS);
       }
     }
 

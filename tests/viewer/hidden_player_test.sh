@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# The viewer's own sphere found inside the pile: a server on an ephemeral
+# loopback port, the viewer under Xvfb, Q held (xdotool) until the sphere is
+# pressed down to the floor under the settled balls, then F12 and the pixel
+# check: no white sphere in view, its amber through the balls instead.
+# Exit 77 (skipped) only without xvfb-run or xdotool.
+#
+# Usage: hidden_player_test.sh SERVER VIEWER CHECKER OUT_DIR
+set -euo pipefail
+server=$1 viewer=$2 checker=$3 out=$4
+source "$(dirname "$0")/start_server.sh"
+
+for tool in xvfb-run xdotool; do
+  if ! command -v "$tool" >/dev/null; then
+    echo "$tool is not installed (scripts/install-deps viewer installs it): skipped"
+    exit 77
+  fi
+done
+rm -rf "$out"
+mkdir -p "$out/work"
+log=$out/server.log
+
+start_server "$log" --balls 1000
+wait_settled "$log"
+
+# The sphere moves at 8 m/s: 4 s of Q take it from the tank's centre (20 m up) to the floor.
+export SERVER_LOG=$log VIEWER=$viewer PORT=$port
+cd "$out/work"
+timeout 150 xvfb-run -a -s "-screen 0 1280x1024x24" bash -euo pipefail -c '
+  "$VIEWER" --connect "127.0.0.1:$PORT" --no-hud 2>viewer.log &
+  viewer_pid=$!
+  window=$(xdotool search --sync --name Fishtank | head -n 1)
+  for _ in $(seq 200); do grep -q "welcomed with player sphere" "$SERVER_LOG" && break; sleep 0.1; done
+  xdotool windowfocus "$window"
+  xdotool keydown q
+  sleep 4
+  xdotool keyup q
+  sleep 1
+  xdotool key F12
+  for _ in $(seq 100); do grep -q "screenshot saved: " viewer.log && break; sleep 0.1; done
+  xdotool key Escape
+  wait "$viewer_pid"
+'
+saved=$(sed -n 's/^fishtank-viewer: screenshot saved: //p' viewer.log)
+if [ -z "$saved" ]; then
+  echo "FAILED: F12 saved no screenshot:"
+  cat viewer.log
+  exit 1
+fi
+"$checker" --own-hidden "$saved"
