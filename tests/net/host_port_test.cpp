@@ -1,8 +1,8 @@
 // The --connect address of the viewer and fishtank-client: a host and a port that can exist, or a refusal.
 
-#include <catch2/catch.hpp>
-
 #include "common/host_port.h"
+
+#include <catch2/catch.hpp>
 
 using fishtank::parse_host_port;
 
@@ -20,9 +20,9 @@ TEST_CASE("host:port gives the host and a port 1 .. 65535, and an IPv6 literal w
 }
 
 TEST_CASE("a port that cannot exist, or no host, is refused rather than tried", "[net][flags]") {
-  for (const char* bad : {"127.0.0.1", "127.0.0.1:", ":7878", "[]:7878", "127.0.0.1:0", "127.0.0.1:65536",
-                          "127.0.0.1:99999", "127.0.0.1:123456", "127.0.0.1:abc", "127.0.0.1:78x", "127.0.0.1:-1",
-                          "127.0.0.1:+80", "127.0.0.1: 80", ""}) {
+  for (const char* bad :
+       {"127.0.0.1", "127.0.0.1:", ":7878", "[]:7878", "127.0.0.1:0", "127.0.0.1:65536", "127.0.0.1:99999",
+        "127.0.0.1:123456", "127.0.0.1:abc", "127.0.0.1:78x", "127.0.0.1:-1", "127.0.0.1:+80", "127.0.0.1: 80", ""}) {
     INFO("--connect " << bad);
     CHECK_FALSE(parse_host_port(bad));
   }
