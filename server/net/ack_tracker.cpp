@@ -9,7 +9,11 @@ namespace fishtank::net {
 void AckTracker::sent(std::uint32_t tick, Clock::time_point now, std::size_t bytes) {
   sent_.push_back(tick);
   if (sent_.size() > protocol::kKeptBases) sent_.pop_front();
-  if (out_.empty()) delivered_at_ = now;  // the link was idle: that time delivered nothing, and does not count
+  if (out_.empty()) {
+    delivered_at_ = now;  // the link was idle: that time delivered nothing, and does not count
+    alone_at_ = now;      // nothing of ours queued before it: its round trip is the path's own
+    queued_since_alone_ = false;
+  }
   out_.push_back({tick, now, bytes, delivered_, delivered_at_});
   if (out_.size() > kMaxOut) out_.pop_front();
 }
@@ -75,19 +79,22 @@ std::optional<AckTracker::Clock::time_point> AckTracker::oldest_unanswered() con
   return out_.front().at;
 }
 
-bool AckTracker::may_send(Clock::time_point now) const {
+bool AckTracker::may_send(Clock::time_point now) {
   if (!acknowledges() || out_.empty()) return true;  // a client that never acknowledges is not held
   if (now - out_.back().at >= kLongestHold) return true;
   // Before its first round trip, one snapshot out: the first is a keyframe, the largest there is.
   if (!round_trips_.best()) return false;
+  if (queued_since_alone_ && now - alone_at_ >= kProbeInterval) return false;  // draining: the next goes alone
   const Clock::duration quickest = *round_trips_.best();
-  if (now - out_.front().at > quickest + kQueueAllowance) return false;  // queueing already
   // Not more out than the link carries in a round trip (kRateInterval at least, as its rate) and the allowance.
   std::uint64_t out_bytes = 0;
   for (const Out& o : out_) out_bytes += o.bytes;
   const double span =
       std::chrono::duration<double>(std::max<Clock::duration>(quickest, kRateInterval) + kQueueAllowance).count();
-  return double(out_bytes) <= delivery_rate() * span;
+  const bool carried =
+      now - out_.front().at <= quickest + kQueueAllowance && double(out_bytes) <= delivery_rate() * span;
+  queued_since_alone_ |= !carried;
+  return carried;
 }
 
 }  // namespace fishtank::net

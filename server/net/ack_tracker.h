@@ -16,7 +16,12 @@
 // plus kQueueAllowance, the link is queueing and the newest snapshot waits for
 // the next Ack instead, though never longer than kLongestHold (a client that
 // acknowledged only some snapshots would otherwise wait for ever). On a fast
-// link the measured rate grows with what is sent, so nothing waits. A client
+// link the measured rate grows with what is sent, so nothing waits. A round
+// trip measured through a queue is longer by it, and once the quicker ones have
+// left the window it would let that queue stay, and grow window by window; so,
+// as BBR's ProbeRTT does, a link found queueing is let drain every
+// kProbeInterval: the next snapshot waits until none is out, and its round trip
+// has no queue in it. A client
 // that said in its Hello that it acknowledges is held from its first snapshot:
 // one out until its Ack, so a slow link starts without a queue. A client that
 // never acknowledges takes every snapshot in full as its connection allows.
@@ -40,6 +45,8 @@ inline constexpr std::chrono::milliseconds kRateInterval{100};
 inline constexpr std::chrono::seconds kLongestHold{1};
 // The quickest round trip is of this span: a path that got slower (a phone roaming) is learnt within it.
 inline constexpr std::chrono::seconds kRoundTripWindow{10};
+// How often a link found queueing is let drain, so that the quickest round trip has no queue in it.
+inline constexpr std::chrono::seconds kProbeInterval{5};
 // Snapshots out and not yet acknowledged whose times are kept: 4 s at 60 a second.
 inline constexpr std::size_t kMaxOut = 256;
 
@@ -59,8 +66,9 @@ class AckTracker {
   std::optional<std::uint32_t> prior() const;
   // Whether the client holds snapshot `tick`: sent to it among the last kKeptBases, and not after base().
   bool keeps(std::uint32_t tick) const;
-  // False while the link is queueing: the next snapshot waits for an Ack.
-  bool may_send(Clock::time_point now) const;
+  // False while the link is queueing, or draining for a round trip without a queue: the next snapshot
+  // waits for an Ack. Not const: it notes that the link queued.
+  bool may_send(Clock::time_point now);
   // When the oldest snapshot not yet answered went out, for a client that acknowledges; empty when none is out.
   std::optional<Clock::time_point> oldest_unanswered() const;
   // The client asked for no more snapshots (Watching off): those out need no answer.
@@ -104,6 +112,8 @@ class AckTracker {
   WindowBest<double, std::greater<>> rates_;              // bytes a second the Acks answered
   std::uint64_t delivered_ = 0;                           // bytes of every snapshot answered so far
   Clock::time_point delivered_at_{};                      // when the last of them was
+  Clock::time_point alone_at_{};     // when a snapshot last went out with none before it unanswered
+  bool queued_since_alone_ = false;  // a snapshot waited for a queueing link since then
   bool expects_acks_ = false;
 };
 

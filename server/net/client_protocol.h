@@ -93,7 +93,7 @@ class ClientProtocol {
     acks_.sent(tick, now, bytes);
   }
   // False while the client's link is queueing snapshots (AckTracker): the newest waits for its next Ack.
-  bool may_send_snapshot(Clock::time_point now = Clock::now()) const { return acks_.may_send(now); }
+  bool may_send_snapshot(Clock::time_point now = Clock::now()) { return acks_.may_send(now); }
   // When the oldest snapshot the client has not answered went out; empty when none is, or it never answers.
   std::optional<Clock::time_point> oldest_unanswered_snapshot() const { return acks_.oldest_unanswered(); }
   // The snapshot the next one may be coded against; empty: send a keyframe.

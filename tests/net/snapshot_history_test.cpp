@@ -319,8 +319,10 @@ struct LinkRun {
 };
 
 // A client behind a link of `bytes_per_s` (0: no limit) and `latency` each way, offered a snapshot of
-// `frame_bytes` every 1/60 s for 10 s, acknowledging each as it arrives, on a clock of 0.1 ms ticks.
-LinkRun run_link(double bytes_per_s, double latency, std::size_t frame_bytes) {
+// `frame_bytes` (the first `first_bytes`, 0: the same) every 1/60 s for `seconds`, acknowledging each as it
+// arrives, on a clock of 0.1 ms ticks; the figures are of the last second.
+LinkRun run_link(double bytes_per_s, double latency, std::size_t frame_bytes, std::size_t first_bytes = 0,
+                 double seconds = 10.0) {
   using Clock = net::AckTracker::Clock;
   const auto at = [](double s) { return Clock::time_point{} + std::chrono::microseconds(std::lround(s * 1e6)); };
   net::AckTracker tracker;
@@ -331,10 +333,10 @@ LinkRun run_link(double bytes_per_s, double latency, std::size_t frame_bytes) {
   bool offered = false;
   std::uint32_t tick = 0;
   LinkRun run;
-  for (double now = 0.0; now < 10.0; now += 1e-4) {
+  for (double now = 0.0; now < seconds; now += 1e-4) {
     for (; !acks.empty() && acks.front().first <= now; acks.pop_front()) {
       tracker.acknowledged(acks.front().second, false, at(now));
-      if (now >= 9.0)
+      if (now >= seconds - 1.0)
         run.slowest_round_trip_last_second =
             std::max(run.slowest_round_trip_last_second, now - sent_at[acks.front().second]);
     }
@@ -344,10 +346,11 @@ LinkRun run_link(double bytes_per_s, double latency, std::size_t frame_bytes) {
     }
     if (!offered || !tracker.may_send(at(now))) continue;
     offered = false;
-    tracker.sent(++tick, at(now), frame_bytes);
+    const double bytes = double(tick == 0 && first_bytes ? first_bytes : frame_bytes);
+    tracker.sent(++tick, at(now), std::size_t(bytes));
     sent_at[tick] = now;
-    run.sent_last_second += now >= 9.0;
-    link_free = std::max(link_free, now + latency) + (bytes_per_s > 0.0 ? frame_bytes / bytes_per_s : 0.0);
+    run.sent_last_second += now >= seconds - 1.0;
+    link_free = std::max(link_free, now + latency) + (bytes_per_s > 0.0 ? bytes / bytes_per_s : 0.0);
     acks.emplace_back(link_free + latency, tick);
   }
   return run;
@@ -373,6 +376,71 @@ TEST_CASE("paced by its Acks, a slow link gets what it carries without a queue, 
   CHECK(run_link(0.0, 0.02, 36'000).sent_last_second >= 59);
   // Loopback.
   CHECK(run_link(0.0, 0.00005, 36'000).sent_last_second >= 59);
+}
+
+TEST_CASE(
+    "over two minutes a slow link's round trip stays what the link carries: a queueing link drains every "
+    "kProbeInterval, a fast one never",
+    "[net][delta]") {
+  // Without the drain each 10 s window's quickest round trip had the last one's queue in it: 4.4 s by then.
+  const LinkRun slow = run_link(50'000, 0.005, 20'000, 0, 120.0);
+  CHECK(slow.sent_last_second >= 2);
+  CHECK(slow.slowest_round_trip_last_second < 2 * 0.4 + 0.1);
+  const LinkRun medium = run_link(150'000, 0.005, 16'000, 0, 120.0);  // 1.39 s without
+  CHECK(medium.sent_last_second >= 8);
+  CHECK(medium.slowest_round_trip_last_second < 2 * 16.0 / 150 + 0.1);
+  // A late joiner: its first round trip is a 36 kB keyframe's, then 12 kB deltas.
+  const LinkRun joiner = run_link(150'000, 0.005, 12'000, 36'000, 120.0);  // 1.04 s without
+  CHECK(joiner.sent_last_second >= 11);
+  CHECK(joiner.slowest_round_trip_last_second < 2 * 12.0 / 150 + 0.1);
+  // Far but fast: never queueing, never drained, every snapshot.
+  const LinkRun far = run_link(0.0, 0.1, 36'000, 0, 120.0);
+  CHECK(far.sent_last_second >= 59);
+  CHECK(far.slowest_round_trip_last_second < 0.21);
+}
+
+TEST_CASE("a link found queueing is let drain kProbeInterval after a snapshot last went out alone", "[net][delta]") {
+  using std::chrono::milliseconds;
+  const net::AckTracker::Clock::time_point t0{};
+  net::AckTracker tracker;
+  tracker.expect_acks();
+  tracker.sent(1, t0, 10'000);
+  tracker.acknowledged(1, false, t0 + milliseconds(100));  // 100 ms, 100 kB/s
+  tracker.sent(2, t0 + milliseconds(100), 10'000);         // alone: nothing out before it
+  tracker.sent(3, t0 + milliseconds(117), 10'000);
+  CHECK_FALSE(tracker.may_send(t0 + milliseconds(134)));  // 20 kB out, 15 kB carried: queueing
+  // Until kProbeInterval after snapshot 2, paced as before: each Ack lets the next go with one still out.
+  std::uint32_t tick = 3;
+  auto now = t0 + milliseconds(117);
+  const auto drain = t0 + milliseconds(100) + net::kProbeInterval;
+  for (; now + milliseconds(100) < drain; now += milliseconds(100)) {
+    tracker.acknowledged(tick - 1, false, now + milliseconds(100));
+    REQUIRE(tracker.may_send(now + milliseconds(100)));
+    tracker.sent(++tick, now + milliseconds(100), 10'000);
+  }
+  now += milliseconds(100);
+  tracker.acknowledged(tick - 1, false, now);
+  // Then the same one out waits: none may be out when the next goes.
+  CHECK_FALSE(tracker.may_send(now));
+  tracker.acknowledged(tick, false, now + milliseconds(60));
+  CHECK(tracker.may_send(now + milliseconds(60)));
+  tracker.sent(++tick, now + milliseconds(60), 10'000);  // alone: its round trip has no queue in it
+  tracker.acknowledged(tick, false, now + milliseconds(140));
+  CHECK(tracker.quickest_round_trip() == milliseconds(80));
+  tracker.sent(++tick, now + milliseconds(140), 10'000);
+  CHECK(tracker.may_send(now + milliseconds(157)));  // paced as before
+
+  // A link that never queued is never drained, however long since one went out alone.
+  net::AckTracker fast;
+  fast.expect_acks();
+  fast.sent(1, t0, 10'000);
+  fast.acknowledged(1, false, t0 + milliseconds(10));
+  for (std::uint32_t tick = 2; tick < 1000; ++tick) {
+    const auto now = t0 + milliseconds(10 * tick);
+    REQUIRE(fast.may_send(now));
+    fast.sent(tick, now, 10'000);
+    if (tick > 2) fast.acknowledged(tick - 1, false, now + milliseconds(1));  // always one out
+  }
 }
 
 TEST_CASE("a client that says in its Hello it acknowledges has one snapshot out until its first Ack, a second at most",
