@@ -9,12 +9,7 @@ set -euo pipefail
 server=$1 viewer=$2 out=$3
 source "$(dirname "$0")/start_server.sh"
 
-for tool in xvfb-run xdotool; do
-  if ! command -v "$tool" >/dev/null; then
-    echo "$tool is not installed (scripts/install-deps viewer installs it): skipped"
-    exit 77
-  fi
-done
+need_tools xvfb-run xdotool
 rm -rf "$out"
 mkdir -p "$out/work"
 log=$out/server.log

@@ -9,10 +9,7 @@ set -euo pipefail
 server=$1 viewer=$2 checker=$3 out=$4
 source "$(dirname "$0")/start_server.sh"
 
-if ! command -v xvfb-run >/dev/null; then
-  echo "xvfb-run is not installed (scripts/install-deps viewer installs it): skipped"
-  exit 77
-fi
+need_tools xvfb-run
 mkdir -p "$out"
 png=$out/viewer_screenshot.png
 log=$out/server.log

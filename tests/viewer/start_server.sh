@@ -2,8 +2,18 @@
 # fishtank-server ($server) on a free loopback port with ARGS, its stderr in
 # LOG, stops it when the test exits, and sets $port (exit 1 when it does not listen).
 # wait_settled LOG waits until every ball is poured and has had 4 s to fall.
+# need_tools TOOL... skips the test (exit 77) where one is not installed.
 # scripts/fishtank_tools.py reads the port, as it does for every script.
 tools="$(dirname "${BASH_SOURCE[0]}")/../../scripts/fishtank_tools.py"
+need_tools() {
+  local tool
+  for tool in "$@"; do
+    if ! command -v "$tool" >/dev/null; then
+      echo "$tool is not installed (scripts/install-deps viewer installs it): skipped"
+      exit 77
+    fi
+  done
+}
 start_server() {
   local log=$1 found
   shift
