@@ -3,6 +3,7 @@
 
   Server        starts a fishtank-server, reads the port from its 'listening on'
                 line (and the web viewer's from 'web viewer on'), stops it;
+  SlowLink      a TCP proxy that carries a server's bytes at a set rate;
   variants()    the builds compared side by side and the flags each runs with;
   bench()       one --bench run of a variant, with the load average around it;
   interleaved() the order of interleaved rounds; spread() and round_ratios(),
@@ -29,10 +30,12 @@ import math
 import os
 import re
 import signal
+import socket
 import statistics
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -184,6 +187,38 @@ class Server:
             self.stop()
         else:
             self.kill()
+
+
+class SlowLink:
+    """A TCP proxy on 127.0.0.1 for one client: the server's bytes reach it at `rate` bytes a second, its own
+    the server at once. A slow link, whose queue forms in the proxy's sockets as in a router's."""
+
+    def __init__(self, server_port, rate):
+        self._listener = socket.create_server(("127.0.0.1", 0))
+        self.port = self._listener.getsockname()[1]
+        self._server_port, self._rate = server_port, rate
+        threading.Thread(target=self._accept, daemon=True).start()
+
+    def _accept(self):
+        client, _ = self._listener.accept()
+        self._listener.close()
+        upstream = socket.create_connection(("127.0.0.1", self._server_port))
+        threading.Thread(target=self._pump, args=(client, upstream, None), daemon=True).start()
+        self._pump(upstream, client, self._rate)
+
+    @staticmethod
+    def _pump(source, sink, rate):
+        start, carried = time.monotonic(), 0
+        try:
+            while chunk := source.recv(4096):
+                sink.sendall(chunk)
+                carried += len(chunk)
+                if rate:
+                    time.sleep(max(0.0, start + carried / rate - time.monotonic()))
+        except OSError:
+            pass  # either side closed
+        finally:
+            sink.close()
 
 
 # ------------------------------------------------------------------ variants and benchmarks

@@ -4,12 +4,18 @@ Frames are FlatBuffers size-prefixed buffers: a 4-byte little-endian length,
 then a Message table with file identifier "FTNK" (protocol/frame_codec.h).
 The controls wait until a snapshot shows their effect, so a script reads
 like the experiment it runs; a refusal from the server raises FishtankError.
+
+A thread of the client's own reads the connection and answers each snapshot
+with an Ack asking for the next in full (the client decodes no deltas), so the
+server paces it by what its link carries, as it does a viewer, and a program
+may take as long as it likes between calls: snapshot() returns the newest.
 """
 
 import math
 import numbers
 import socket
 import struct
+import threading
 import time
 from dataclasses import dataclass
 
@@ -17,7 +23,7 @@ import flatbuffers
 import numpy as np
 
 from fishtank._protocol import PROTOCOL_VERSION
-from fishtank.wire import (AddBalls, BallKinds, Error, ErrorCode, Hello, InLine, Message, Pause, Payload, Ping,
+from fishtank.wire import (Ack, AddBalls, BallKinds, Error, ErrorCode, Hello, InLine, Message, Pause, Payload, Ping,
                            PlayerGranted, PlayerInput, Pong, Reset, SetTimeScale, Snapshot as WireSnapshot, Step,
                            Vec3f, Welcome)
 
@@ -133,26 +139,33 @@ class Client:
         self.address = f"[{host}]:{port}" if ":" in str(host) else f"{host}:{port}"
         self._sock = self._connect(host, port)
         self._sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self._buffer = bytearray()
-        self._kinds = np.zeros(0, dtype=np.uint8)
-        self._newest = None  # the newest Snapshot read, not yet returned by snapshot()
-        self._last = None  # the newest Snapshot seen
+        # What the reader thread writes, the caller reads under this; it is notified of every frame.
+        self._changed = threading.Condition()
+        self._send_lock = threading.Lock()  # the caller's frames and the reader's Acks
+        self._kinds = np.zeros(0, dtype=np.uint8)  # replaced, never changed: a snapshot keeps the one it came with
+        self._newest = None  # the newest snapshot received, not yet returned by snapshot(): (table, kinds)
+        self._last = None  # the newest snapshot received
+        self._received = 0  # snapshots received
         self._sequence = 0
-        self._pong = None
+        self._pong = None  # (its stamp, snapshots received before it)
+        self._ended = None  # why the reader stopped, raised to the caller
+        self._closing = False
         self.errors = []  # every FishtankError the server sent, oldest first
         self._unraised = []  # refusals not yet raised to the caller
         self.welcome = None
         self.ahead_in_line = None  # in line for a sphere: how many clients are before this one (InLine)
         self._send(_frame(Payload.Payload.Hello, lambda b: self._hello(b, name, player)))
-        deadline = time.monotonic() + timeout
-        while self.welcome is None:
-            self._read_one(deadline)
-        w = self.welcome
-        self.player_id = w.PlayerId() if w.HasPlayer() else None
+        self._reader = threading.Thread(target=self._read, name=f"fishtank reader {self.address}", daemon=True)
+        self._reader.start()
+        try:
+            self._wait(lambda: self.welcome is not None, time.monotonic() + timeout)
+        except BaseException:
+            self.close()
+            raise
+        w = self.welcome  # player_id and may_control: the reader set them, and keeps them
         self.dt = w.Dt()
         self.steps_per_contact = w.StepsPerContact()  # contact duration of the lightest pair / dt
         self.tolerance = w.Tolerance()  # the per-collision error dt was chosen for; 0: dt given
-        self.may_control = w.MayControl()
         self.control_policy = _text(w.ControlPolicy())
         self.kinds = [(w.BallKinds(k).Diameter(), w.BallKinds(k).Mass()) for k in range(w.BallKindsLength())]
         self._tank = (_vec(w.TankMin()), _vec(w.TankMax()))
@@ -161,33 +174,26 @@ class Client:
 
     def snapshot(self):
         """The newest snapshot, waiting for one newer than the last returned if none has arrived."""
-        self._drain()
-        deadline = time.monotonic() + self.timeout
-        while self._newest is None:
-            self._read_one(deadline)
-        self._drain()
-        s, self._newest = self._newest, None
-        return s
+        return self._decode_snapshot(*self._wait(self._take_newest, time.monotonic() + self.timeout))
 
     def wait_for_player(self, timeout=None):
         """Waits until this client holds a player sphere and returns its id: at once where it has one, else once
         a sphere another client frees comes to it, first in line. Raises FishtankError "no_player" where it is
         not in line (it asked for none, or the server has none) and "timeout" where none came in time (default:
         the client's timeout)."""
-        deadline = time.monotonic() + (self.timeout if timeout is None else timeout)
-        while self.player_id is None:
+        def holds():
             # The refusal and the place in line come before any snapshot, so a snapshot without them means no line.
-            if self.ahead_in_line is None and self._last is not None:
+            if self.player_id is None and self.ahead_in_line is None and self._last is not None:
                 raise FishtankError("no_player", "this client is not in line for a player sphere" +
                                     self._last_error_text())
-            self._read_one(deadline)
+            return self.player_id is not None
+
+        self._wait(holds, time.monotonic() + (self.timeout if timeout is None else timeout))
         return self.player_id
 
     def move(self, velocity):
         """Sets the player sphere's velocity (metres per second, x y z); it keeps it until the next move()."""
-        if self.player_id is None:
-            self._drain()  # a sphere freed by another may have come meanwhile (PlayerGranted)
-        if self.player_id is None:
+        if self.player_id is None:  # the reader takes a sphere freed by another (PlayerGranted) as it comes
             raise FishtankError("no_player", "this client has no player sphere to move")
         # Checked here, not refused by the server later: move() does not wait, so a refusal would be raised
         # by whichever call came next.
@@ -245,7 +251,13 @@ class Client:
         return self._wait_for(lambda s: s.time_scale_set == scale)
 
     def close(self):
+        self._closing = True
+        try:
+            self._sock.shutdown(socket.SHUT_RDWR)  # wakes the reader: a close alone may leave it in recv()
+        except OSError:
+            pass  # the server closed it already
         self._sock.close()
+        self._reader.join(self.timeout)
 
     def __enter__(self):
         return self
@@ -281,6 +293,7 @@ class Client:
         Hello.AddProtocolVersion(b, PROTOCOL_VERSION)
         Hello.AddClientName(b, text)
         Hello.AddWantsPlayer(b, bool(player))
+        Hello.AddAcknowledges(b, True)
         return Hello.End(b)
 
     @staticmethod
@@ -307,79 +320,109 @@ class Client:
         return self._wait_for(lambda s: s.scene_start != before)
 
     def _send(self, frame):
-        self._sock.sendall(frame)
+        with self._send_lock:
+            self._sock.sendall(frame)
 
-    # ---- receiving ----
+    # ---- receiving: the caller's side ----
 
-    def _current(self):
-        """The newest snapshot received so far."""
-        self._drain()
-        if self._last is None:
-            self.snapshot()
-        return self._last
+    def _wait(self, ready, deadline):
+        """Waits until ready() (called under the lock) returns something true, and returns that; raises why the
+        connection ended, or FishtankError "timeout" at the deadline."""
+        with self._changed:
+            while True:
+                value = ready()
+                if value:
+                    return value
+                if self._ended is not None:
+                    raise self._ended
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    raise self._timed_out()
+                self._changed.wait(left)
 
-    def _wait_for(self, done):
-        """Reads until a snapshot satisfies done (returned) or the server refuses (FishtankError)."""
-        deadline = time.monotonic() + self.timeout
-        while True:
-            self._check_refusals()
-            if self._newest is not None and done(self._newest):
-                s, self._newest = self._newest, None
-                return s
-            self._newest = None
-            self._read_one(deadline)
+    def _take_newest(self):
+        s, self._newest = self._newest, None
+        return s
 
-    def _round_trip(self):
-        """Waits for a Pong, so that any immediate refusal of what was sent before has arrived."""
-        self._pong = None
-        stamp = int(time.monotonic() * 1e6) % 2**32
-        self._send(_frame(Payload.Payload.Ping, lambda b: self._table(b, Ping, AddClientTimeUs=stamp)))
-        deadline = time.monotonic() + self.timeout
-        while self._pong != stamp:
-            self._read_one(deadline)
-        # A physics-thread answer (AddBalls' tank_full) goes out before the first snapshot published after
-        # the command was applied; the second snapshot after the Pong is surely later than that.
-        for _ in range(2):
-            self._wait_for(lambda s: True)
-
-    def _check_refusals(self):
-        self._drain()
+    def _raise_refusal(self):
+        """Raises the oldest refusal not raised yet, forgetting any after it (under the lock)."""
         if self._unraised:
             error = self._unraised[0]
             self._unraised.clear()
             raise error
 
-    def _drain(self):
-        """Handles every frame already received, without waiting."""
-        self._sock.setblocking(False)
+    def _take_refusal_or_newest(self):
+        self._raise_refusal()
+        return self._take_newest()
+
+    def _current(self):
+        """The newest snapshot received so far."""
+        if self._last is None:
+            self.snapshot()
+        return self._decode_snapshot(*self._last)
+
+    def _wait_for(self, done):
+        """Waits for a snapshot that satisfies done (returned), or a refusal from the server (FishtankError)."""
+        deadline = time.monotonic() + self.timeout
+        while True:
+            s = self._decode_snapshot(*self._wait(self._take_refusal_or_newest, deadline))
+            if done(s):
+                return s
+
+    def _round_trip(self):
+        """Waits for a Pong, so that any immediate refusal of what was sent before has arrived."""
+        stamp = int(time.monotonic() * 1e6) % 2**32
+        self._send(_frame(Payload.Payload.Ping, lambda b: self._table(b, Ping, AddClientTimeUs=stamp)))
+        deadline = time.monotonic() + self.timeout
+        _, before = self._wait(lambda: self._pong if self._pong and self._pong[0] == stamp else None, deadline)
+        # A physics-thread answer (AddBalls' tank_full) goes out before the first snapshot published after
+        # the command was applied; the second snapshot after the Pong is surely later than that.
+        self._wait(lambda: self._received >= before + 2, deadline)
+        with self._changed:
+            self._take_newest()
+        self._check_refusals()
+
+    def _check_refusals(self):
+        with self._changed:
+            self._raise_refusal()
+            if self._ended is not None:
+                raise self._ended
+
+    # ---- receiving: the reader thread ----
+
+    def _read(self):
+        """Reads frames until the connection ends, then leaves why in _ended for the caller."""
+        buffer = bytearray()
         try:
             while True:
-                chunk = self._sock.recv(1 << 20)
+                try:
+                    chunk = self._sock.recv(1 << 20)
+                except TimeoutError:  # the caller's waits have deadlines of their own
+                    continue
                 if not chunk:
                     raise ConnectionError("the server closed the connection")
-                self._buffer += chunk
-        except BlockingIOError:
-            pass
-        finally:
-            self._sock.settimeout(self.timeout)
-        while self._handle_buffered():
-            pass
+                buffer += chunk
+                while (frame := self._split_frame(buffer)) is not None:
+                    tick = self._handle(Message.Message.GetRootAs(frame, 4))
+                    if tick is not None:
+                        self._acknowledge(tick)
+        except Exception as e:  # noqa: BLE001  (whatever ended it is the caller's to see)
+            if self._closing:
+                e = ConnectionError("this client was closed")
+            elif isinstance(e, ConnectionError) and str(e) == "the server closed the connection":
+                e = ConnectionError(str(e) + self._last_error_text())
+            elif isinstance(e, OSError) and not isinstance(e, ConnectionError):
+                e = ConnectionError(f"the connection to {self.address} failed: {e.strerror or e}")
+            with self._changed:
+                self._ended = e
+                self._changed.notify_all()
 
-    def _read_one(self, deadline):
-        """Handles at least one more frame, waiting until the deadline for it."""
-        while not self._handle_buffered():
-            left = deadline - time.monotonic()
-            if left <= 0:
-                raise self._timed_out()
-            self._sock.settimeout(left)
-            try:
-                chunk = self._sock.recv(1 << 20)
-            except TimeoutError:  # socket.timeout is TimeoutError since Python 3.10
-                raise self._timed_out() from None
-            if not chunk:
-                raise ConnectionError("the server closed the connection" + self._last_error_text())
-            self._buffer += chunk
-        self._sock.settimeout(self.timeout)
+    def _acknowledge(self, tick):
+        """Ack with want_keyframe: this client holds no base to decode a delta against, so the next comes in full."""
+        try:
+            self._send(_frame(Payload.Payload.Ack, lambda b: self._table(b, Ack, AddTick=tick, AddWantKeyframe=True)))
+        except OSError:
+            pass  # the server closed the connection: the frames before that say why, and then recv() ends
 
     def _timed_out(self):
         return FishtankError("timeout", f"no answer from the server at {self.address} within {self.timeout:g} s; "
@@ -389,78 +432,88 @@ class Client:
     def _last_error_text(self):
         return f" ({self.errors[-1]})" if self.errors else ""
 
-    def _handle_buffered(self):
-        """Handles one complete frame from the buffer; False when none is complete."""
-        if len(self._buffer) < 4:
-            return False
-        (length,) = struct.unpack_from("<I", self._buffer)
+    @staticmethod
+    def _split_frame(buffer):
+        """Takes one complete frame off the front of the buffer; None when none is complete."""
+        if len(buffer) < 4:
+            return None
+        (length,) = struct.unpack_from("<I", buffer)
         if length < 8 or length > _MAX_FRAME_BYTES:
             raise ConnectionError(f"frame length {length} is outside 8 .. {_MAX_FRAME_BYTES} bytes")
-        if len(self._buffer) < 4 + length:
-            return False
-        frame = bytes(self._buffer[: 4 + length])
-        del self._buffer[: 4 + length]
+        if len(buffer) < 4 + length:
+            return None
+        frame = bytes(buffer[: 4 + length])
+        del buffer[: 4 + length]
         if frame[8:12] != _IDENTIFIER:
             raise ConnectionError("not a Fishtank frame (file identifier is not FTNK)")
-        self._handle(Message.Message.GetRootAs(frame, 4))
-        return True
+        return frame
 
     def _handle(self, m):
+        """Takes one frame in, under the lock, and wakes the caller; returns a snapshot's tick, to acknowledge."""
         kind = m.PayloadType()
         table = m.Payload()
         if table is None:
-            return
-        if kind == Payload.Payload.Welcome:
-            self.welcome = Welcome.Welcome()
-            self.welcome.Init(table.Bytes, table.Pos)
-        elif kind == Payload.Payload.BallKinds:
-            k = BallKinds.BallKinds()
-            k.Init(table.Bytes, table.Pos)
-            first = k.FirstNewBall()
-            if first > len(self._kinds):
-                raise ConnectionError("the server skipped ball kinds")
-            # Earlier than the kinds known: a scene started again, ids restart.
-            self._kinds = np.concatenate([self._kinds[:first], k.KindsAsNumpy()]).astype(np.uint8)
-        elif kind == Payload.Payload.Snapshot:
-            s = WireSnapshot.Snapshot()
-            s.Init(table.Bytes, table.Pos)
-            self._newest = self._last = self._decode_snapshot(s)
-        elif kind == Payload.Payload.Error:
-            e = Error.Error()
-            e.Init(table.Bytes, table.Pos)
-            error = FishtankError(_ERROR_NAMES.get(e.Code(), str(e.Code())), _text(e.Message()))
-            self.errors.append(error)
-            if self.welcome is None:
-                raise error
-            if error.code == "player_idle":  # the sphere was freed; the client observes
-                self.player_id = None
-            if error.code != "player_limit":  # the Welcome says so too: this client observes, in line for a sphere
-                self._unraised.append(error)
-        elif kind == Payload.Payload.PlayerGranted:
-            g = PlayerGranted.PlayerGranted()
-            g.Init(table.Bytes, table.Pos)
-            self.player_id = g.PlayerId()
-            self.may_control = g.MayControl()
-            self.ahead_in_line = None
-        elif kind == Payload.Payload.InLine:
-            line = InLine.InLine()
-            line.Init(table.Bytes, table.Pos)
-            self.ahead_in_line = line.Ahead()
-        elif kind == Payload.Payload.Pong:
-            p = Pong.Pong()
-            p.Init(table.Bytes, table.Pos)
-            self._pong = p.ClientTimeUs()
+            return None
+        tick = None
+        with self._changed:
+            if kind == Payload.Payload.Welcome:
+                self.welcome = Welcome.Welcome()
+                self.welcome.Init(table.Bytes, table.Pos)
+                self.player_id = self.welcome.PlayerId() if self.welcome.HasPlayer() else None
+                self.may_control = self.welcome.MayControl()
+            elif kind == Payload.Payload.BallKinds:
+                k = BallKinds.BallKinds()
+                k.Init(table.Bytes, table.Pos)
+                first = k.FirstNewBall()
+                if first > len(self._kinds):
+                    raise ConnectionError("the server skipped ball kinds")
+                # Earlier than the kinds known: a scene started again, ids restart.
+                self._kinds = np.concatenate([self._kinds[:first], k.KindsAsNumpy()]).astype(np.uint8)
+            elif kind == Payload.Payload.Snapshot:
+                s = WireSnapshot.Snapshot()
+                s.Init(table.Bytes, table.Pos)
+                # Decoded when the caller takes it: most are replaced by a newer one before that.
+                self._newest = self._last = (s, self._kinds)
+                self._received += 1
+                tick = s.Tick()
+            elif kind == Payload.Payload.Error:
+                e = Error.Error()
+                e.Init(table.Bytes, table.Pos)
+                error = FishtankError(_ERROR_NAMES.get(e.Code(), str(e.Code())), _text(e.Message()))
+                self.errors.append(error)
+                if self.welcome is None:
+                    raise error
+                if error.code == "player_idle":  # the sphere was freed; the client observes
+                    self.player_id = None
+                if error.code != "player_limit":  # the Welcome says so too: this client observes, in line
+                    self._unraised.append(error)
+            elif kind == Payload.Payload.PlayerGranted:
+                g = PlayerGranted.PlayerGranted()
+                g.Init(table.Bytes, table.Pos)
+                self.player_id = g.PlayerId()
+                self.may_control = g.MayControl()
+                self.ahead_in_line = None
+            elif kind == Payload.Payload.InLine:
+                line = InLine.InLine()
+                line.Init(table.Bytes, table.Pos)
+                self.ahead_in_line = line.Ahead()
+            elif kind == Payload.Payload.Pong:
+                p = Pong.Pong()
+                p.Init(table.Bytes, table.Pos)
+                self._pong = (p.ClientTimeUs(), self._received)
+            self._changed.notify_all()
+        return tick
 
-    def _decode_snapshot(self, s):
+    def _decode_snapshot(self, s, kinds):
         n = s.BallCount()
         lo, hi = (_vec(s.TankMin()), _vec(s.TankMax())) if s.TankMin() is not None else self._tank
         q = s.PositionsAsNumpy() if n else np.zeros(0, dtype=np.uint16)
-        if len(q) != 3 * n or len(self._kinds) < n:
+        if len(q) != 3 * n or len(kinds) < n:
             raise ConnectionError("a snapshot's positions or kinds do not match its ball count")
         players = s.PlayerPositionsLength()
         return Snapshot(
             positions=dequantize(q.reshape(n, 3), lo, hi),
-            kinds=self._kinds[:n].copy(),
+            kinds=kinds[:n].copy(),
             ids=np.arange(n, dtype=np.uint32),
             player_ids=s.PlayerIdsAsNumpy().astype(np.uint32) if players else np.zeros(0, dtype=np.uint32),
             player_positions=np.array([_vec(s.PlayerPositions(i)) for i in range(players)],

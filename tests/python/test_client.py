@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 import fishtank
+import fishtank_tools  # scripts/, on the path from server_process (conftest.py)
 from fishtank import Client, FishtankError
 
 
@@ -328,6 +329,30 @@ def test_add_balls_beyond_the_rate_limit_says_rate_limited_before_the_tank_is_fu
         with pytest.raises(FishtankError) as limited:
             tank.add_balls(100000)
     assert limited.value.code == "rate_limited" and "added 3000 of 100000" in limited.value.message
+
+
+def test_a_program_that_reads_less_often_than_the_servers_idle_timeout_keeps_its_connection(start_server):
+    """Snapshots the program has not asked for yet do not pile up in the sockets until the server gives up on
+    the connection (a write stalled for --idle-timeout): the client reads them as they come."""
+    server = start_server("--balls", "6000", "--idle-timeout", "2")
+    with Client("127.0.0.1", server.port, player=False) as tank:
+        first = tank.snapshot()
+        time.sleep(10)  # a plot, a fit, a breakpoint
+        later = tank.snapshot()
+    assert later.sim_time > first.sim_time + 9, (first.sim_time, later.sim_time)  # the newest, not one queued
+
+
+def test_over_a_slow_link_the_server_paces_the_client_so_its_snapshots_stay_fresh(start_server):
+    """The client acknowledges each snapshot as it arrives, so a link slower than the snapshots gets fewer of
+    them, not a queue: 2000 balls are 12 kB a snapshot, 720 kB/s at 60 a second, through 100 kB/s."""
+    server = start_server("--balls", "2000")
+    link = fishtank_tools.SlowLink(server.port, 100_000)
+    with Client("127.0.0.1", link.port, player=False) as slow, Client("127.0.0.1", server.port, player=False) as fast:
+        deadline = time.monotonic() + 12
+        while time.monotonic() < deadline:
+            slow.snapshot()
+        behind = fast.snapshot().sim_time - slow.snapshot().sim_time
+    assert behind < 1.0, f"through 100 kB/s the newest snapshot is {behind:.1f} s behind the server's"
 
 
 def test_the_assembled_package_is_readable_by_every_user():
