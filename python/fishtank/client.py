@@ -399,8 +399,8 @@ class Client:
                     chunk = self._sock.recv(1 << 20)
                 except TimeoutError:  # the caller's waits have deadlines of their own
                     continue
-                if not chunk:
-                    raise ConnectionError("the server closed the connection")
+                if not chunk:  # the frames before it, handled on this thread, hold any reason the server gave
+                    raise ConnectionError("the server closed the connection" + self._last_error_text())
                 buffer += chunk
                 while (frame := self._split_frame(buffer)) is not None:
                     tick = self._handle(Message.Message.GetRootAs(frame, 4))
@@ -409,8 +409,6 @@ class Client:
         except Exception as e:  # noqa: BLE001  (whatever ended it is the caller's to see)
             if self._closing:
                 e = ConnectionError("this client was closed")
-            elif isinstance(e, ConnectionError) and str(e) == "the server closed the connection":
-                e = ConnectionError(str(e) + self._last_error_text())
             elif isinstance(e, OSError) and not isinstance(e, ConnectionError):
                 e = ConnectionError(f"the connection to {self.address} failed: {e.strerror or e}")
             with self._changed:
