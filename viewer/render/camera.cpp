@@ -6,7 +6,7 @@
 namespace fishtank::viewer {
 namespace {
 
-constexpr float kFovY = 0.7854f;  // 45 degrees
+constexpr float kFov = 0.7854f;  // 45 degrees, across the window's narrower side
 constexpr float kOrbitRadiansPerPixel = 0.005f;
 constexpr float kMaxPitch = 1.5f;  // just short of straight down, where look_at degenerates
 
@@ -17,9 +17,9 @@ void OrbitCamera::frame(const TankBounds& tank) {
   // Aim a little below the centre: the pile sits on the floor, and from above
   // the floor would otherwise crowd the bottom of the picture.
   target_ = tank.min + Vec3{size.x * 0.5f, size.y * 0.45f, size.z * 0.5f};
-  // The bounding sphere of the box fits the vertical field of view.
+  // The bounding sphere of the box fits the field of view, whichever the aspect.
   float radius = 0.5f * length(size);
-  distance_ = radius / std::sin(kFovY * 0.5f);
+  distance_ = radius / std::sin(kFov * 0.5f);
   min_distance_ = 0.05f * radius;
   max_distance_ = 6.0f * radius;
   yaw_ = 0.0f;
@@ -41,7 +41,10 @@ Vec3 OrbitCamera::eye() const {
 }
 
 Mat4 OrbitCamera::view_projection(float aspect) const {
-  return perspective(kFovY, aspect, 0.1f, distance_ + max_distance_) *
+  // A tall window (a phone held upright) widens the vertical field, so that
+  // the horizontal one stays kFov and the tank still fits across.
+  float fov_y = aspect >= 1.0f ? kFov : 2.0f * std::atan(std::tan(kFov * 0.5f) / aspect);
+  return perspective(fov_y, aspect, 0.1f, distance_ + max_distance_) *
          look_at(eye(), target_, {0.0f, 1.0f, 0.0f});
 }
 

@@ -10,7 +10,7 @@ namespace fishtank::viewer {
 
 class OrbitCamera {
  public:
-  // Frames the whole tank at the given aspect ratio from slightly above.
+  // Frames the whole tank from slightly above, at any aspect ratio.
   void frame(const TankBounds& tank);
 
   void orbit(float dx_pixels, float dy_pixels);

@@ -5,7 +5,7 @@
 export type Vec3 = [number, number, number];
 export type Mat4 = Float32Array;  // column-major, as WebGL takes it
 
-const FOV_Y = Math.PI / 4;
+const FOV = Math.PI / 4;  // across the canvas's narrower side
 const ORBIT_RADIANS_PER_PIXEL = 0.005;
 const MAX_PITCH = 1.5;  // just short of straight down, where lookAt degenerates
 export const ZOOM_PER_STEP = 0.9;  // the distance's factor per wheel step (or its worth of a pinch)
@@ -51,13 +51,13 @@ export class OrbitCamera {
   private minDistance = 2;
   private maxDistance = 400;
 
-  // Frames the whole tank from slightly above, aiming a little below its centre
-  // where the pile sits.
+  // Frames the whole tank from slightly above, at any aspect ratio, aiming a
+  // little below its centre where the pile sits.
   frame(min: Vec3, max: Vec3): void {
     const size = sub(max, min);
     this.target = [min[0] + 0.5 * size[0], min[1] + 0.45 * size[1], min[2] + 0.5 * size[2]];
     const radius = 0.5 * Math.hypot(size[0], size[1], size[2]);
-    this.distance = radius / Math.sin(FOV_Y / 2);
+    this.distance = radius / Math.sin(FOV / 2);
     this.minDistance = 0.05 * radius;
     this.maxDistance = 6 * radius;
     this.yaw = 0;
@@ -84,7 +84,10 @@ export class OrbitCamera {
   }
 
   viewProjection(aspect: number): Mat4 {
-    return multiply(perspective(FOV_Y, aspect, 0.1, this.distance + this.maxDistance), lookAt(this.eye(), this.target, [0, 1, 0]));
+    // A tall canvas (a phone held upright) widens the vertical field, so that
+    // the horizontal one stays FOV and the tank still fits across.
+    const fovY = aspect >= 1 ? FOV : 2 * Math.atan(Math.tan(FOV / 2) / aspect);
+    return multiply(perspective(fovY, aspect, 0.1, this.distance + this.maxDistance), lookAt(this.eye(), this.target, [0, 1, 0]));
   }
 
   forwardOnGround(): Vec3 {
