@@ -6,6 +6,7 @@
 #include <malloc.h>
 #endif
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -38,6 +39,8 @@ constexpr int kWindowHeight = 1024;
 constexpr float kPlayerSpeed = 8.0f;  // m/s; the server clamps at its own maximum
 constexpr std::uint32_t kBallsPerPress = 1000;
 constexpr float kOutlineGrow = 1.35f;
+constexpr float kOutlineMinPixels =
+    8.0f;  // the ring's outer radius at least, so that a distant sphere is found
 const std::array<std::uint8_t, 4> kOutlineRgba{255, 176, 32, 255};
 constexpr float kHiddenAlpha = 0.8f;  // the own sphere's amber over the balls in front of it
 
@@ -282,7 +285,13 @@ int run_viewer(const ViewerOptions& opt) {
       if (own >= 0) {
         SphereInstance mine = instances[static_cast<std::size_t>(own)];
         mine.rgba = kOutlineRgba;
-        spheres.draw_outline(view_proj, mine, kOutlineGrow);
+        float scale = 1.0f;  // framebuffer pixels per screen point (HiDPI)
+        glfwGetWindowContentScale(window, nullptr, &scale);
+        const float radius_px =
+            radius_on_screen(view_proj, {mine.x, mine.y, mine.z}, mine.radius, float(height));
+        const float grow =
+            radius_px > 0.0f ? std::max(kOutlineGrow, kOutlineMinPixels * scale / radius_px) : kOutlineGrow;
+        spheres.draw_outline(view_proj, mine, grow);
         spheres.draw_hidden(view_proj, mine, kHiddenAlpha);
       }
       if (show_tank) tank_outline.draw(view_proj);

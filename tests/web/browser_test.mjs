@@ -53,7 +53,7 @@ after(async () => {
   await server?.stop();
 });
 
-test('the page gets a WebGL2 context and a screenshot shows red, green and blue balls and the white player', async () => {
+test('the page gets a WebGL2 context and a screenshot shows red, green and blue balls and the white player in its ring', async () => {
   const s = await waitForState(page, (st) => st.drawnBalls > 0 && st.ownPlayerDrawn, 'balls and the player drawn');
   assert.ok(s.webgl2, 'a WebGL2 context');
   // The player starts amid the pouring balls; lifted above them (E), it is in plain view.
@@ -65,7 +65,7 @@ test('the page gets a WebGL2 context and a screenshot shows red, green and blue 
   await page.keyboard.press('F1');  // the HUD off: its text is not the scene
   // Balls still pouring past the lifted sphere can hide it in one frame: up to ten frames, 300 ms apart.
   let c, png;
-  for (let tries = 0; tries < 10 && !(c?.white >= 20); ++tries) {
+  for (let tries = 0; tries < 10 && !(c?.white >= 20 && c?.amber >= 100); ++tries) {
     await sleep(300);
     png = await page.screenshot({ type: 'png' });
     c = await countColours(page, png);
@@ -77,6 +77,9 @@ test('the page gets a WebGL2 context and a screenshot shows red, green and blue 
   assert.ok(c.red >= 100 && c.green >= 100 && c.blue >= 100, `red, green and blue balls visible: ${summary}`);
   assert.ok(c.blue > c.red && c.green > c.red, `the larger green and blue balls cover more than red: ${summary}`);
   assert.ok(c.white >= 20 && c.white < 0.01 * c.total, `the small white player sphere: ${summary}`);
+  // A sphere about 4 px in radius from the default camera: its ring reaches 8 px (OUTLINE_MIN_PX), about
+  // 150 px of amber where the ring of a 1.35 times larger sphere would be 50.
+  assert.ok(c.amber >= 100, `the amber ring around it 8 px in radius: ${summary}`);
 });
 
 test('the HUD says how the server chose dt: 13 steps per contact from the default tolerance', async () => {

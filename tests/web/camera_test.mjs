@@ -1,13 +1,26 @@
 // The page's orbit camera (web/src/camera.ts, bundled for node by tests/web/CMakeLists.txt): its first view
-// holds the whole tank whatever the canvas's shape, a phone held upright as well as a wide monitor.
+// holds the whole tank whatever the canvas's shape, a phone held upright as well as a wide monitor, and it
+// measures how large a sphere is on screen (the own sphere's ring has a least size).
 
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 import { need } from './harness.mjs';
 
-const { OrbitCamera } = await import(need('FISHTANK_WEB_MODULE'));
+const { OrbitCamera, radiusOnScreen } = await import(need('FISHTANK_WEB_MODULE'));
 
-// The largest |x| and |y| of the tank's eight corners in normalised device coordinates.
+const sub = (a, b) => a.map((v, i) => v - b[i]);
+const add = (a, b) => a.map((v, i) => v + b[i]);
+const scale = (a, k) => a.map((v) => v * k);
+const norm = (a) => scale(a, 1 / Math.hypot(...a));
+const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+
+// Where `p` lands on a canvas `heightPx` tall, in pixels from its centre.
+function onScreen(m, p, heightPx, aspect) {
+  const clip = [0, 1, 2, 3].map((row) => [...p, 1].reduce((sum, v, col) => sum + m[col * 4 + row] * v, 0));
+  return [0.5 * heightPx * aspect * clip[0] / clip[3], 0.5 * heightPx * clip[1] / clip[3]];
+}
+
+// The largest |x| and |y| of the tank's eight corners in normalised device coordinates (m: column-major).
 function cornersReach(min, max, aspect) {
   const camera = new OrbitCamera();
   camera.frame(min, max);
@@ -35,5 +48,30 @@ test('the first view holds the whole tank on a tall, square or wide canvas, the 
       const where = `${t.name} at aspect ${aspect}: reaches x ${x.toFixed(3)}, y ${y.toFixed(3)}`;
       assert.ok(x < 1 && y < 1, `${where}; a corner is off the canvas`);
       if (t.notSmall) assert.ok(Math.max(x, y) > 0.5, `${where}; not even halfway to an edge`);
+    }
+});
+
+test('a sphere\'s radius on screen is the pixels from its centre to its outline\'s top, near or far, tall or wide', () => {
+  for (const aspect of [0.46, 1.25])
+    for (const wheel of [0, 10, -8]) {
+      const camera = new OrbitCamera();
+      camera.frame([-20, 0, -20], [20, 40, 20]);
+      camera.zoom(wheel);
+      const m = camera.viewProjection(aspect);
+      // A sphere on the line of sight through the target (the view's centre); the top of its outline is where
+      // the tangent from the eye along the camera's up axis touches it.
+      const eye = camera.eye();
+      const sight = norm(sub([0, 18, 0], eye));
+      const up = norm(cross(cross(sight, [0, 1, 0]), sight));
+      const distance = 0.6 * Math.hypot(...sub([0, 18, 0], eye));
+      const centre = add(eye, scale(sight, distance));
+      const radius = 0.5;
+      const angle = Math.asin(radius / distance);
+      const top = add(eye, scale(add(scale(sight, Math.cos(angle)), scale(up, Math.sin(angle))), distance));
+      const [cx, cy] = onScreen(m, centre, 1000, aspect);
+      const [tx, ty] = onScreen(m, top, 1000, aspect);
+      const expected = Math.hypot(tx - cx, ty - cy);
+      const got = radiusOnScreen(m, centre, radius, 1000);
+      assert.ok(Math.abs(got - expected) < 0.01 * expected, `aspect ${aspect}, wheel ${wheel}: ${got} px, ${expected} expected`);
     }
 });

@@ -67,4 +67,14 @@ inline Mat4 look_at(Vec3 eye, Vec3 target, Vec3 up) {
   return r;
 }
 
+// The radius in pixels of a sphere of `radius` at `centre`, on a viewport
+// `height_px` tall: row 1 of a perspective times a look-at is the focal
+// length times the camera's up axis, row 3 the depth.
+inline float radius_on_screen(const Mat4& view_proj, Vec3 centre, float radius, float height_px) {
+  float depth = view_proj.at(3, 0) * centre.x + view_proj.at(3, 1) * centre.y +
+                view_proj.at(3, 2) * centre.z + view_proj.at(3, 3);
+  float focal = length(Vec3{view_proj.at(1, 0), view_proj.at(1, 1), view_proj.at(1, 2)});
+  return depth > 0.0f ? radius * focal * 0.5f * height_px / depth : 0.0f;
+}
+
 }  // namespace fishtank::viewer

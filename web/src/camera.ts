@@ -43,6 +43,16 @@ function lookAt(eye: Vec3, target: Vec3, up: Vec3): Mat4 {
                            -dot(u, eye), dot(f, eye), 1]);
 }
 
+// The radius in pixels of a sphere of `radius` at `centre`, on a viewport
+// `heightPx` tall (viewer/render/math.h): row 1 of a perspective times a
+// look-at is the focal length times the camera's up axis, row 3 the depth.
+export function radiusOnScreen(viewProj: Mat4, centre: Vec3, radius: number, heightPx: number): number {
+  const m = viewProj;  // column-major: m[col * 4 + row]
+  const depth = m[3] * centre[0] + m[7] * centre[1] + m[11] * centre[2] + m[15];
+  const focal = Math.hypot(m[1], m[5], m[9]);
+  return depth > 0 ? (radius * focal * 0.5 * heightPx) / depth : 0;
+}
+
 export class OrbitCamera {
   private target: Vec3 = [0, 20, 0];
   private yaw = 0;  // radians around +y; 0 looks along -z

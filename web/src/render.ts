@@ -8,7 +8,7 @@
 // dequantises over the tank and looks up radius and colour by kind, so no
 // per-ball work is done in JavaScript and no matrix exists per ball.
 
-import type { Mat4, Vec3 } from './camera';
+import { radiusOnScreen, type Mat4, type Vec3 } from './camera';
 import type { Pair, Player } from './snapshots';
 
 export interface BallKind {
@@ -19,6 +19,7 @@ export interface BallKind {
 const MAX_KINDS = 16;  // the shader's table; Welcome lists 3
 const PLAYER_RADIUS = 0.5;  // kPlayerDiameter / 2 (common/tank.h)
 const OUTLINE_GROW = 1.35;
+const OUTLINE_MIN_PX = 8;  // CSS pixels: the ring's outer radius at least, so that a distant sphere is found
 const OUTLINE_COLOUR: Vec3 = [1.0, 0.72, 0.1];
 const HIDDEN_ALPHA = 0.8;  // the own sphere's amber over the balls in front of it
 const CLEAR: [number, number, number] = [0.055, 0.066, 0.09];
@@ -239,8 +240,12 @@ export class Renderer {
       gl.drawElementsInstanced(gl.TRIANGLES, this.indexCount, gl.UNSIGNED_SHORT, 0, players.length);
       if (ownIndex >= 0) {
         // The inside of a larger, unlit sphere: a ring around the silhouette.
-        gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(players[ownIndex].pos), gl.DYNAMIC_DRAW);
-        gl.uniform1f(this.playerU.u_radius, PLAYER_RADIUS * OUTLINE_GROW);
+        const own = players[ownIndex].pos;
+        const radiusPx = radiusOnScreen(viewProj, own, PLAYER_RADIUS, gl.drawingBufferHeight);
+        const minPx = OUTLINE_MIN_PX * (window.devicePixelRatio || 1);
+        const grow = radiusPx > 0 ? Math.max(OUTLINE_GROW, minPx / radiusPx) : OUTLINE_GROW;
+        gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(own), gl.DYNAMIC_DRAW);
+        gl.uniform1f(this.playerU.u_radius, PLAYER_RADIUS * grow);
         gl.uniform3fv(this.playerU.u_colour, OUTLINE_COLOUR);
         gl.uniform1i(this.playerU.u_unlit, 1);
         gl.cullFace(gl.FRONT);
