@@ -106,6 +106,25 @@ test('the page decodes delta snapshots against its Acks without asking for a key
   assert.equal(s.keyframeRequests, 0);
 });
 
+test('a lost WebGL context is said in the HUD, and once the browser restores it the page draws the balls again', async () => {
+  // WEBGL_lose_context does what a GPU reset or a phone reclaiming a background tab's memory does.
+  await page.evaluate(() => {
+    window.loseContext = document.getElementById('view').getContext('webgl2').getExtension('WEBGL_lose_context');
+    window.loseContext.loseContext();
+  });
+  await waitForState(page, (st) => st.contextLost, 'the context lost');
+  assert.match(await waitForHud(page, (t) => /context lost/.test(t)), /WebGL context lost\): it draws again/);
+  await page.evaluate(() => window.loseContext.restoreContext());
+  await waitForState(page, (st) => st.contextLost === false, 'the context restored');
+  let c;
+  for (let tries = 0; tries < 10 && !(c?.red >= 100 && c?.green >= 100 && c?.blue >= 100); ++tries) {
+    await sleep(300);
+    c = await countColours(page, await page.screenshot({ type: 'png' }));
+  }
+  assert.ok(c.red >= 100 && c.green >= 100 && c.blue >= 100, `red, green and blue balls drawn again: ${JSON.stringify(c)}`);
+  assert.doesNotMatch(await waitForHud(page, (t) => !/context lost/.test(t)), /context lost/);
+});
+
 test('B pours 1000 balls in: the server\'s count rises and the HUD shows it', async () => {
   const before = (await waitForState(page, (st) => st.serverBalls > 0, 'a snapshot')).serverBalls;
   await page.keyboard.press('KeyB');

@@ -22,8 +22,22 @@ const wsUrl = params.get('ws') ?? `${location.protocol === 'https:' ? 'wss' : 'w
 
 const canvas = document.getElementById('view') as HTMLCanvasElement;
 const gl = canvas.getContext('webgl2', { antialias: true });
-const renderer = gl ? new Renderer(gl) : null;
+let renderer = gl ? new Renderer(gl) : null;
 const webglProblem = gl ? '' : 'This browser gives the page no WebGL2 context: nothing can be drawn (the HUD still works).';
+// A GPU reset, or a phone reclaiming memory from a tab in the background, takes
+// the context and everything made in it; preventDefault asks for it back.
+let contextLost = false;
+canvas.addEventListener('webglcontextlost', (e) => {
+  e.preventDefault();
+  contextLost = true;
+  renderer = null;
+});
+canvas.addEventListener('webglcontextrestored', () => {
+  renderer = new Renderer(gl!);
+  kindsOf = null;  // the new renderer is told the kinds again
+  contextLost = false;
+});
+const CONTEXT_LOST = 'The GPU took this page\'s drawing away (WebGL context lost): it draws again once the browser gives it back.';
 const overlay = document.getElementById('overlay')!;
 const input = new Input(canvas, overlay);
 const camera = new OrbitCamera();
@@ -99,7 +113,8 @@ function frame(nowMs: number): void {
     frames = 0;
     fpsStarted = nowMs;
   }
-  hud.update(net, { fps, frameMs, now, renderDelayMs: 1000 * net.snapshots.renderDelay(), observerAsked, webgl: webglProblem });
+  hud.update(net, { fps, frameMs, now, renderDelayMs: 1000 * net.snapshots.renderDelay(), observerAsked,
+                    webgl: contextLost ? CONTEXT_LOST : webglProblem });
   requestAnimationFrame(frame);
 }
 requestAnimationFrame(frame);
@@ -110,6 +125,7 @@ net.setVisible(document.visibilityState !== 'hidden');
 (window as unknown as { fishtank: unknown }).fishtank = {
   state: () => ({
     webgl2: gl !== null,
+    contextLost,
     connection: net.state,
     welcomes: net.welcomes,
     watching: net.watching,
