@@ -292,7 +292,7 @@ int run_viewer(const ViewerOptions& opt) {
         const float grow =
             radius_px > 0.0f ? std::max(kOutlineGrow, kOutlineMinPixels * scale / radius_px) : kOutlineGrow;
         spheres.draw_outline(view_proj, mine, grow);
-        spheres.draw_hidden(view_proj, mine, kHiddenAlpha);
+        spheres.draw_hidden(view_proj, mine, grow, kHiddenAlpha);
       }
       if (show_tank) tank_outline.draw(view_proj);
       hud.render();

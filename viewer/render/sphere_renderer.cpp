@@ -127,10 +127,11 @@ void SphereRenderer::draw_outline(const Mat4& view_proj, const SphereInstance& s
   glBindVertexArray(0);
 }
 
-void SphereRenderer::draw_hidden(const Mat4& view_proj, const SphereInstance& sphere, float alpha) {
+void SphereRenderer::draw_hidden(const Mat4& view_proj, const SphereInstance& sphere, float grow,
+                                 float alpha) {
   glUseProgram(program_);
   glUniformMatrix4fv(u_view_proj_, 1, GL_FALSE, view_proj.data());
-  glUniform1f(u_grow_, 1.0f);
+  glUniform1f(u_grow_, grow);
   glUniform1i(u_unlit_, GL_TRUE);
   glBindVertexArray(vao_);
   upload(&sphere, 1);

@@ -23,10 +23,11 @@ class SphereRenderer {
   // only (the "inverted hull"), so the real sphere drawn in front hides all
   // but a rim. Marks the viewer's own player among other white ones.
   void draw_outline(const Mat4& view_proj, const SphereInstance& sphere, float grow);
-  // Where what was drawn before hides the sphere, its flat colour blended over
-  // that at `alpha` (the depth test passes only behind): the viewer's own sphere
-  // found inside the pile it starts in. Where it is in view, nothing changes.
-  void draw_hidden(const Mat4& view_proj, const SphereInstance& sphere, float alpha);
+  // Where what was drawn before hides the sphere grown by `grow` (its ring's
+  // size), its flat colour blended over that at `alpha` (the depth test passes
+  // only behind): the viewer's own sphere and ring found inside the pile it
+  // starts in. Where they are in view, nothing changes.
+  void draw_hidden(const Mat4& view_proj, const SphereInstance& sphere, float grow, float alpha);
 
  private:
   void upload(const SphereInstance* spheres, std::size_t count);

@@ -251,9 +251,9 @@ export class Renderer {
         gl.cullFace(gl.FRONT);
         gl.drawElementsInstanced(gl.TRIANGLES, this.indexCount, gl.UNSIGNED_SHORT, 0, 1);
         gl.cullFace(gl.BACK);
-        // Where balls hide it (the sphere starts amid the pour), the sphere again, amber and
-        // blended over them: only the depth test's GREATER passes, so the visible part stays white.
-        gl.uniform1f(this.playerU.u_radius, PLAYER_RADIUS);
+        // Where balls hide it (the sphere starts amid the pour), the sphere at the ring's size
+        // again, amber and blended over them: only the depth test's GREATER passes, so what is
+        // in view stays as drawn.
         gl.depthFunc(gl.GREATER);
         gl.depthMask(false);
         gl.enable(gl.BLEND);
