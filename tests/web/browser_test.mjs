@@ -160,7 +160,7 @@ test('holding D moves the player sphere to the camera\'s right (+x at the start)
   assert.ok(Math.abs(moved.pos[2] - start.pos[2]) < 0.5, `not along z: ${JSON.stringify([start, moved])}`);
 });
 
-test('on a touch screen a pad appears at the first touch: a pinch zooms, the stick moves the sphere forward, +1000 pours balls', async () => {
+test('on a touch screen a pad appears at the first touch: a pinch zooms, the stick moves the sphere forward, +1000 pours balls; on its side the statistics leave the pile in view', async () => {
   const phone = await browser.newPage();
   phone.on('pageerror', (e) => pageErrors.push(String(e)));
   await phone.setViewport({ width: 420, height: 640, hasTouch: true, isMobile: true });
@@ -203,6 +203,12 @@ test('on a touch screen a pad appears at the first touch: a pinch zooms, the sti
   });
   await phone.touchscreen.tap(add[0], add[1]);
   await waitForState(phone, (st) => st.serverBalls >= before + 1000, `${before + 1000} balls`);
+
+  // Turned on its side, the statistics take two columns across the top and leave the pile in view.
+  await phone.setViewport({ width: 844, height: 390, hasTouch: true, isMobile: true });
+  await sleep(500);
+  const stats = await phone.$eval('#stats', (e) => JSON.parse(JSON.stringify(e.getBoundingClientRect())));
+  assert.ok(stats.height < 0.45 * 390, `the statistics ${stats.height} px tall of 390 on a phone on its side`);
   await phone.close();
 });
 
