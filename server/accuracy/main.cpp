@@ -235,7 +235,9 @@ int main(int argc, char** argv) {
     run_collisions(o);
     if (o.collisions_only) return 0;
     run_rows(o);
-    run_accuracy(o, SceneConfig{2.5e4, 0.6, o.kernels});
+    SceneConfig config;
+    config.kernels = o.kernels;
+    run_accuracy(o, config);
     run_stability(o);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fishtank-accuracy: %s\n", e.what());

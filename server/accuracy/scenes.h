@@ -19,6 +19,7 @@
 
 #include "server/accuracy/contact_1d.h"
 #include "server/physics/kernels.h"
+#include "server/physics/params.h"
 
 namespace fishtank::accuracy {
 
@@ -32,8 +33,8 @@ struct Method {
 const std::vector<Method>& methods();
 
 struct SceneConfig {
-  double k = 2.0e4;          // the study's k (docs/accuracy.md); the product's default is now 2.5e4
-  double restitution = 0.6;  // product default
+  double k = PhysicsParams{}.stiffness;  // the product's defaults
+  double restitution = PhysicsParams{}.restitution;
   const Kernels* kernels = &kSseKernels;
 };
 
