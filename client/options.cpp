@@ -78,7 +78,7 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
     po::store(parse_flags(argc, argv, flags), vm);
     po::notify(vm);
   } catch (const po::error& e) {
-    return fail(e.what());
+    return fail(flag_error_text(e, flags));
   }
   if (vm.count("help")) {
     std::ostringstream help;

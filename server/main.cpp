@@ -54,12 +54,16 @@ int write_final_state(const fishtank::World& world, const fishtank::ServerOption
   return err.empty() && !recorder.failed() ? 0 : 1;
 }
 
-// Whether --dump's file and --export-lammps's folder can be written (the folder is made); if not, why, on stderr.
-bool final_state_writable(const fishtank::ServerOptions& o) {
+// Whether --dump's and --record's files and --export-lammps's folder can be written (the folder is made); if
+// not, why, on stderr: checked before the run, not found when it ends.
+bool outputs_writable(const fishtank::ServerOptions& o) {
   std::string error;
   if (!o.dump_path.empty())
     if (const std::string why = fishtank::check_writable_file(o.dump_path); !why.empty())
       error = "--dump " + o.dump_path + ": " + why;
+  if (error.empty() && !o.record.path.empty())
+    if (const std::string why = fishtank::check_writable_file(o.record.path); !why.empty())
+      error = "--record " + o.record.path + ": " + why;
   if (error.empty() && !o.lammps_dir.empty())
     if (const std::string why = fishtank::prepare_writable_folder(o.lammps_dir); !why.empty())
       error = "--export-lammps " + o.lammps_dir + ": " + why;
@@ -83,7 +87,7 @@ bool apply_max_balls(fishtank::World& world, const fishtank::ServerOptions& o) {
 }
 
 int run_bench(const fishtank::ServerOptions& o) {
-  if (!final_state_writable(o)) return 2;
+  if (!outputs_writable(o)) return 2;
   fishtank::World world(o.physics, kKernels, o.threads, o.bench_spec.scene.seed);
   fishtank::TunedStepper stepper(world, !o.fixed_threads);
   if (!apply_max_balls(world, o)) return 2;
@@ -183,7 +187,7 @@ fishtank::SceneChoice scene_choice(const fishtank::ServerOptions& o) {
 }
 
 int run_server(const fishtank::ServerOptions& o) {
-  if (!final_state_writable(o)) return 2;
+  if (!outputs_writable(o)) return 2;
   spdlog::set_default_logger(spdlog::stderr_logger_mt("fishtank-server"));
   fishtank::ActiveScene scene(scene_choice(o));
   fishtank::PhysicsParams params = o.physics;

@@ -1,9 +1,11 @@
 #include "server/options.h"
 
 #include <algorithm>
+#include <boost/asio/ip/address.hpp>
 #include <boost/program_options.hpp>
 #include <cmath>
 #include <sstream>
+#include <vector>
 
 #include "common/flag_values.h"
 #include "common/number_text.h"
@@ -126,7 +128,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "automatic dt = contact duration / this (>= 10; 0: from --tolerance)")(
       "dt", po::value(&o.physics.dt)->default_value(0.0), "fixed time step in seconds (0: automatic)")(
       "skin", po::value(&o.physics.skin)->default_value(defaults.skin, "0"),
-      "neighbour-list skin, units (0: follows the motion, 0.1-1)");
+      "neighbour-list skin, units, up to 10 (0: follows the motion, 0.1-1)");
 
   po::options_description bench("Benchmark");
   bench.add_options()("bench", po::bool_switch(&o.bench), "run unpaced without network and print one JSON object")(
@@ -151,7 +153,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
     po::notify(vm);
   } catch (const po::error& e) {
     result.exit_code = 2;
-    result.message = std::string("fishtank-server: ") + e.what() + "\nTry --help for the list of options.";
+    result.message = "fishtank-server: " + flag_error_text(e, all) + "\nTry --help for the list of options.";
     return result;
   }
   if (vm.count("help")) {
@@ -207,6 +209,17 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
                 std::to_string(PhysicsParams::kMinStepsPerContact) + " and 100000, got " +
                 std::to_string(steps_per_contact));
 
+  // Each sets the time step: of two, one would go unused without a word.
+  std::vector<std::string> step_flags;
+  if (!vm["tolerance"].defaulted()) step_flags.push_back("--tolerance " + number_text(o.physics.tolerance));
+  if (steps_per_contact != 0) step_flags.push_back("--steps-per-contact " + std::to_string(steps_per_contact));
+  if (o.physics.dt != 0.0f) step_flags.push_back("--dt " + number_text(o.physics.dt));
+  if (step_flags.size() > 1)
+    return fail("--tolerance, --steps-per-contact and --dt each set the time step; give one of them, got " +
+                step_flags[0] + " and " + step_flags[1]);
+
+  if (boost::system::error_code ec; boost::asio::ip::make_address(o.bind, ec), ec)
+    return fail("--bind takes an IP address, such as 127.0.0.1, 0.0.0.0, ::1 or ::, got '" + o.bind + "'");
   if (port < 0 || port > 65535) return fail("--port must be between 0 and 65535, got " + std::to_string(port));
   if (web_port < 0 || web_port > 65535)
     return fail("--web-port must be between 0 and 65535, got " + std::to_string(web_port));

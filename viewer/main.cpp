@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
       ("connect", po::value(&connect), "server to connect to, host:port (default 127.0.0.1:7878)")      //
       ("fullscreen", po::bool_switch(&opt.fullscreen), "start in full screen (F11 toggles)")            //
       ("observer", po::bool_switch(&opt.observer), "watch only: no player sphere of our own")           //
-      ("no-hud", "start with the statistics hidden (F1 toggles)")                                       //
+      ("no-hud", "start with the statistics and live plots hidden (F1, F2 toggle)")                      //
       ("outline", po::bool_switch(&opt.tank_outline), "start with the tank's edges shown (T toggles)")  //
       ("screenshot", po::value(&opt.screenshot),
        "render --frames frames after the first snapshot, save the last "
@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
     po::store(fishtank::parse_flags(argc, argv, flags), vm);
     po::notify(vm);
   } catch (const po::error& e) {
-    return refuse(e.what());
+    return refuse(fishtank::flag_error_text(e, flags));
   }
   if (vm.count("help")) {
     std::cout << flags << "\n";

@@ -75,7 +75,7 @@ std::optional<Options> parse(int argc, char** argv, int& exit_code) {
     po::store(parse_flags(argc, argv, flags), vm);
     po::notify(vm);
   } catch (const po::error& e) {
-    return refuse(e.what());
+    return refuse(flag_error_text(e, flags));
   }
   if (vm.count("help")) {
     std::cout << flags << "\n";

@@ -196,8 +196,9 @@ Outcome ClientProtocol::on_add_balls(std::uint32_t count, Clock::time_point now)
   Outcome out;
   if (allowed < count)
     out = refuse(wire::ErrorCode::rate_limited,
-                 "added " + std::to_string(allowed) + " of " + std::to_string(count) + " balls: each client may add " +
-                     std::to_string(std::lround(limits.add_balls_per_minute)) + " a minute (--add-rate)",
+                 "added at most " + std::to_string(allowed) + " of " + std::to_string(count) +
+                     " balls: each client may add " + std::to_string(std::lround(limits.add_balls_per_minute)) +
+                     " a minute (--add-rate)",
                  /*disconnect=*/false);
   if (allowed > 0 && balls_.take(allowed, now)) out.command = Command{client_id_, AddBallsCommand{allowed}};
   return out;

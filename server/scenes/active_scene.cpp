@@ -21,7 +21,15 @@ std::string ActiveScene::start(World& world, const std::optional<std::string>& s
   if (choice_.max_balls > 0)
     if (const std::string refusal = world.set_max_balls(choice_.max_balls); !refusal.empty())
       limit_note_ = "scene " + choice_.name + ": --max-balls: " + refusal + "; the tank's capacity is the limit";
-  std::string refusal = populate(world, s);
+  std::string refusal;
+  SceneSpec placed = s;
+  // --max-balls bounds every scene, not only what AddBalls pours in.
+  if (choice_.max_balls > 0 && placed.balls > choice_.max_balls) {
+    placed.balls = choice_.max_balls;
+    refusal = "the " + s.name + " scene: --max-balls lets in " + std::to_string(placed.balls) + " of the " +
+              std::to_string(s.balls) + " balls asked for";
+  }
+  if (std::string fewer = populate(world, placed); !fewer.empty()) refusal = fewer;
   world.respawn_players();
   ++starts_;
   return refusal;

@@ -17,7 +17,7 @@ struct SceneChoice {
   std::string name = "tank";
   std::uint64_t seed = 1;
   std::optional<std::uint32_t> balls;  // every scene's count; empty: each scene's default_balls
-  std::uint32_t max_balls = 0;         // most balls AddBalls may bring; 0: the tank's capacity
+  std::uint32_t max_balls = 0;         // most balls a scene or AddBalls may bring; 0: the tank's capacity
 };
 
 class ActiveScene {

@@ -396,7 +396,7 @@ TEST_CASE("abuse: an observer may not add balls, a player only its allowance (no
   CHECK(observer.has_error("not_permitted"));
   CHECK(player.has_error("rate_limited"));
   REQUIRE_FALSE(player.state().errors.empty());
-  CHECK_THAT(player.state().errors.front(), Catch::Contains("added 600 of 100000"));
+  CHECK_THAT(player.state().errors.front(), Catch::Contains("added at most 600 of 100000"));
   CHECK(balls <= 900);
   CHECK_FALSE(observer.state().closed);  // refused commands do not cost the connection
   CHECK(rate >= kHonestRate);

@@ -328,7 +328,7 @@ def test_add_balls_beyond_the_rate_limit_says_rate_limited_before_the_tank_is_fu
     with Client("127.0.0.1", server.port) as tank:
         with pytest.raises(FishtankError) as limited:
             tank.add_balls(100000)
-    assert limited.value.code == "rate_limited" and "added 3000 of 100000" in limited.value.message
+    assert limited.value.code == "rate_limited" and "added at most 3000 of 100000" in limited.value.message
 
 
 def test_a_program_that_reads_less_often_than_the_servers_idle_timeout_keeps_its_connection(start_server):

@@ -198,3 +198,17 @@ TEST_CASE("a scene whose tank holds fewer balls than --max-balls says so, and it
   CHECK(scene.limit_note().empty());
   CHECK(world.max_balls() == 6000);
 }
+
+TEST_CASE("every scene keeps to --max-balls 500: the tank's pour and the wide scene's lattice, each saying so",
+          "[scenes]") {
+  SceneChoice choice;  // no --balls: the wide scene's own 6000
+  choice.max_balls = 500;
+  ActiveScene scene(choice);
+  PhysicsParams params;
+  params.tank = scene.first_tank();
+  World world(params, kSseKernels, 1, 1);
+  CHECK(scene.start(world) == "the tank scene: --max-balls lets in 500 of the 1000 balls asked for");
+  const std::string refusal = scene.start(world, std::string("wide"));
+  CHECK(world.ball_count() == 500);
+  CHECK(refusal == "the wide scene: --max-balls lets in 500 of the 6000 balls asked for");
+}

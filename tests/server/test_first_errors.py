@@ -71,12 +71,13 @@ def test_a_port_in_use_names_the_flag_and_port_0_and_no_banner_comes_first():
     assert "Ctrl-C stops" not in second.stderr and "listening on" not in second.stderr
 
 
-def test_final_state_paths_that_cannot_be_written_are_refused_before_anything_runs(tmp_path):
+def test_output_paths_that_cannot_be_written_are_refused_before_anything_runs(tmp_path):
     a_file = tmp_path / "a-file"
     a_file.write_text("")
     refusals = {
         ("--dump", str(tmp_path / "missing" / "final.csv")): f"the folder {tmp_path / 'missing'} does not exist",
         ("--dump", str(tmp_path)): "is a folder",
+        ("--record", str(tmp_path / "missing" / "run.dump")): f"the folder {tmp_path / 'missing'} does not exist",
         ("--export-lammps", str(a_file / "lammps")): "cannot create",
     }
     for (flag, path), why in refusals.items():
