@@ -58,10 +58,10 @@ TEST_CASE(
     "a sphere's radius on screen is the pixels from its centre to its outline's top, near or far, tall or "
     "wide",
     "[camera]") {
-  for (float aspect : {0.46f, 1.25f}) {
-    OrbitCamera camera;
-    camera.frame(TankBounds{});
-    for (float zoom : {0.0f, 10.0f, -8.0f}) {
+  for (float aspect : {0.46f, 1.25f})
+    for (float zoom : {0.0f, 10.0f, -8.0f}) {  // as framed, nearer, farther
+      OrbitCamera camera;
+      camera.frame(TankBounds{});
       camera.zoom(zoom);
       Mat4 vp = camera.view_projection(aspect);
       // A sphere on the line of sight through the target, so that its outline's top is the point straight
@@ -82,7 +82,14 @@ TEST_CASE(
       CHECK(radius_on_screen(vp, centre, radius, height_px) ==
             Approx(std::hypot(tx - cx, ty - cy)).epsilon(0.01));
     }
-  }
+}
+
+TEST_CASE(
+    "the own sphere's ring reaches 8 px however small the sphere is on screen, and is 1.35 times a large one",
+    "[camera]") {
+  CHECK(outline_grow(2.5f, 8.0f, 1.35f) * 2.5f == Approx(8.0f));  // a phone's first view: 16 px across
+  CHECK(outline_grow(20.0f, 8.0f, 1.35f) == 1.35f);
+  CHECK(outline_grow(0.0f, 8.0f, 1.35f) == 1.35f);  // behind the camera: nothing to grow
 }
 
 }  // namespace

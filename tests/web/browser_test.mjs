@@ -64,22 +64,35 @@ test('the page gets a WebGL2 context and a screenshot shows red, green and blue 
   await waitForState(page, (st) => st.ownPlayerDrawn[1] > y0 + 5, 'the lifted player drawn');
   await page.keyboard.press('F1');  // the HUD off: its text is not the scene
   // Balls still pouring past the lifted sphere can hide it in one frame: up to ten frames, 300 ms apart.
-  let c, png;
-  for (let tries = 0; tries < 10 && !(c?.white >= 20 && c?.amber >= 100); ++tries) {
-    await sleep(300);
-    png = await page.screenshot({ type: 'png' });
-    c = await countColours(page, png);
-  }
+  const screenshot = async (done) => {
+    let c, png;
+    for (let tries = 0; tries < 10 && !(c && done(c)); ++tries) {
+      await sleep(300);
+      png = await page.screenshot({ type: 'png' });
+      c = await countColours(page, png);
+    }
+    return [c, png];
+  };
+  // From the first view the sphere is about 4 px in radius: its ring reaches 8 px (OUTLINE_MIN_PX), about
+  // 150 px of amber where the ring of a 1.35 times larger sphere would be 50.
+  const [ring] = await screenshot((c) => c.amber >= 100);
+  assert.ok(ring.amber >= 100, `the amber ring around it 8 px in radius: ${JSON.stringify(ring)}`);
+  // Three wheel steps nearer (0.73 of the distance), so that the sphere's white is counted in 40-odd pixels,
+  // not 20-odd; undone afterwards.
+  const far = (await waitForState(page, (st) => st.cameraDistance > 0, 'a camera')).cameraDistance;
+  await page.mouse.move(400, 300);
+  for (let i = 0; i < 3; ++i) await page.mouse.wheel({ deltaY: -100 });
+  await waitForState(page, (st) => st.cameraDistance < 0.75 * far, 'the camera three steps nearer');
+  const [c, png] = await screenshot((n) => n.white >= 20);
   fs.writeFileSync(path.join(outDir, 'web-page.png'), png);
+  for (let i = 0; i < 3; ++i) await page.mouse.wheel({ deltaY: 100 });
+  await waitForState(page, (st) => Math.abs(st.cameraDistance - far) < 0.01 * far, 'the camera back where it was');
   await page.keyboard.press('F1');
   const summary = JSON.stringify(c);
   assert.ok(c.background < 0.995 * c.total, `not blank: ${summary}`);
   assert.ok(c.red >= 100 && c.green >= 100 && c.blue >= 100, `red, green and blue balls visible: ${summary}`);
   assert.ok(c.blue > c.red && c.green > c.red, `the larger green and blue balls cover more than red: ${summary}`);
   assert.ok(c.white >= 20 && c.white < 0.01 * c.total, `the small white player sphere: ${summary}`);
-  // A sphere about 4 px in radius from the default camera: its ring reaches 8 px (OUTLINE_MIN_PX), about
-  // 150 px of amber where the ring of a 1.35 times larger sphere would be 50.
-  assert.ok(c.amber >= 100, `the amber ring around it 8 px in radius: ${summary}`);
 });
 
 test('the HUD says how the server chose dt: 13 steps per contact from the default tolerance', async () => {

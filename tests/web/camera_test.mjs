@@ -6,7 +6,7 @@ import assert from 'node:assert/strict';
 import { test } from 'node:test';
 import { need } from './harness.mjs';
 
-const { OrbitCamera, radiusOnScreen } = await import(need('FISHTANK_WEB_MODULE'));
+const { OrbitCamera, outlineGrow, radiusOnScreen } = await import(need('FISHTANK_WEB_MODULE'));
 
 const sub = (a, b) => a.map((v, i) => v - b[i]);
 const add = (a, b) => a.map((v, i) => v + b[i]);
@@ -74,4 +74,10 @@ test('a sphere\'s radius on screen is the pixels from its centre to its outline\
       const got = radiusOnScreen(m, centre, radius, 1000);
       assert.ok(Math.abs(got - expected) < 0.01 * expected, `aspect ${aspect}, wheel ${wheel}: ${got} px, ${expected} expected`);
     }
+});
+
+test('the own sphere\'s ring reaches 8 px however small the sphere is on screen, and is 1.35 times a large one', () => {
+  assert.ok(Math.abs(outlineGrow(2.5, 8, 1.35) * 2.5 - 8) < 1e-9, 'a phone\'s first view: 16 px across');
+  assert.equal(outlineGrow(20, 8, 1.35), 1.35);
+  assert.equal(outlineGrow(0, 8, 1.35), 1.35, 'behind the camera: nothing to grow');
 });

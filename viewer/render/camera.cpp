@@ -40,7 +40,9 @@ Vec3 OrbitCamera::eye() const {
   return target_ + Vec3{-std::sin(yaw_) * c, std::sin(pitch_), std::cos(yaw_) * c} * distance_;
 }
 
-Mat4 OrbitCamera::view_projection(float aspect) const {
+Mat4 OrbitCamera::view_projection(float window_aspect) const {
+  const float aspect =
+      window_aspect > 0.0f && std::isfinite(window_aspect) ? window_aspect : 1.0f;  // minimised
   // A tall window (a phone held upright) widens the vertical field, so that
   // the horizontal one stays kFov and the tank still fits across.
   float fov_y = aspect >= 1.0f ? kFov : 2.0f * std::atan(std::tan(kFov * 0.5f) / aspect);

@@ -3,6 +3,7 @@
 // layout glUniformMatrix4fv takes without transposing), a perspective and a
 // look-at transform. Vectors are common/vec3.h's, shared with the server.
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -75,6 +76,12 @@ inline float radius_on_screen(const Mat4& view_proj, Vec3 centre, float radius, 
                 view_proj.at(3, 2) * centre.z + view_proj.at(3, 3);
   float focal = length(Vec3{view_proj.at(1, 0), view_proj.at(1, 1), view_proj.at(1, 2)});
   return depth > 0.0f ? radius * focal * 0.5f * height_px / depth : 0.0f;
+}
+
+// How much the own sphere's ring grows its radius: `grow`, or more where the
+// sphere is small on screen, so that the ring reaches `min_px`.
+inline float outline_grow(float radius_px, float min_px, float grow) {
+  return radius_px > 0.0f ? std::max(grow, min_px / radius_px) : grow;
 }
 
 }  // namespace fishtank::viewer

@@ -17,6 +17,7 @@ layout(location = 1) in vec4 i_centre_radius;
 layout(location = 2) in vec4 i_colour;
 uniform mat4 u_view_proj;
 uniform float u_grow;
+uniform float u_depth_grow;
 out vec3 v_normal;
 out vec3 v_colour;
 void main() {
@@ -24,6 +25,11 @@ void main() {
   v_colour = i_colour.rgb;
   vec3 world = i_centre_radius.xyz + a_unit * (i_centre_radius.w * u_grow);
   gl_Position = u_view_proj * vec4(world, 1.0);
+  // The hidden pass: the ring's size at the sphere's own depth, so that what hides the sphere turns amber.
+  if (u_depth_grow != u_grow) {
+    vec4 at = u_view_proj * vec4(i_centre_radius.xyz + a_unit * (i_centre_radius.w * u_depth_grow), 1.0);
+    gl_Position.z = at.z / at.w * gl_Position.w;
+  }
 }
 )";
 
@@ -43,12 +49,18 @@ void main() {
 }
 )";
 
+// The hidden pass takes its depth from a sphere a tenth larger than the own one:
+// just in front of its surface, so that where the sphere is in view, the amber
+// never ties with it in the depth test.
+constexpr float kHiddenDepthGrow = 1.1f;
+
 }  // namespace
 
 SphereRenderer::SphereRenderer() {
   program_ = build_program(kVertexShader, kFragmentShader);
   u_view_proj_ = glGetUniformLocation(program_, "u_view_proj");
   u_grow_ = glGetUniformLocation(program_, "u_grow");
+  u_depth_grow_ = glGetUniformLocation(program_, "u_depth_grow");
   u_unlit_ = glGetUniformLocation(program_, "u_unlit");
 
   SphereMesh mesh = make_uv_sphere(12, 12);
@@ -106,6 +118,7 @@ void SphereRenderer::draw(const Mat4& view_proj, const std::vector<SphereInstanc
   glUseProgram(program_);
   glUniformMatrix4fv(u_view_proj_, 1, GL_FALSE, view_proj.data());
   glUniform1f(u_grow_, 1.0f);
+  glUniform1f(u_depth_grow_, 1.0f);
   glUniform1i(u_unlit_, GL_FALSE);
   glBindVertexArray(vao_);
   upload(spheres.data(), spheres.size());
@@ -118,6 +131,7 @@ void SphereRenderer::draw_outline(const Mat4& view_proj, const SphereInstance& s
   glUseProgram(program_);
   glUniformMatrix4fv(u_view_proj_, 1, GL_FALSE, view_proj.data());
   glUniform1f(u_grow_, grow);
+  glUniform1f(u_depth_grow_, grow);
   glUniform1i(u_unlit_, GL_TRUE);
   glBindVertexArray(vao_);
   upload(&sphere, 1);
@@ -132,6 +146,7 @@ void SphereRenderer::draw_hidden(const Mat4& view_proj, const SphereInstance& sp
   glUseProgram(program_);
   glUniformMatrix4fv(u_view_proj_, 1, GL_FALSE, view_proj.data());
   glUniform1f(u_grow_, grow);
+  glUniform1f(u_depth_grow_, kHiddenDepthGrow);
   glUniform1i(u_unlit_, GL_TRUE);
   glBindVertexArray(vao_);
   upload(&sphere, 1);

@@ -23,10 +23,10 @@ class SphereRenderer {
   // only (the "inverted hull"), so the real sphere drawn in front hides all
   // but a rim. Marks the viewer's own player among other white ones.
   void draw_outline(const Mat4& view_proj, const SphereInstance& sphere, float grow);
-  // Where what was drawn before hides the sphere grown by `grow` (its ring's
-  // size), its flat colour blended over that at `alpha` (the depth test passes
-  // only behind): the viewer's own sphere and ring found inside the pile it
-  // starts in. Where they are in view, nothing changes.
+  // Where what was drawn before hides the sphere, a disc of the sphere grown by
+  // `grow` (its ring's size) at the sphere's own depth, its flat colour blended
+  // over that at `alpha` (the depth test passes only behind): the viewer's own
+  // sphere found inside the pile it starts in. Where it is in view, nothing changes.
   void draw_hidden(const Mat4& view_proj, const SphereInstance& sphere, float grow, float alpha);
 
  private:
@@ -40,6 +40,7 @@ class SphereRenderer {
   GLsizei index_count_ = 0;
   GLint u_view_proj_ = -1;
   GLint u_grow_ = -1;
+  GLint u_depth_grow_ = -1;
   GLint u_unlit_ = -1;
 };
 

@@ -53,6 +53,12 @@ export function radiusOnScreen(viewProj: Mat4, centre: Vec3, radius: number, hei
   return depth > 0 ? (radius * focal * 0.5 * heightPx) / depth : 0;
 }
 
+// How much the own sphere's ring grows its radius: `grow`, or more where the
+// sphere is small on screen, so that the ring reaches `minPx` (viewer/render/math.h).
+export function outlineGrow(radiusPx: number, minPx: number, grow: number): number {
+  return radiusPx > 0 ? Math.max(grow, minPx / radiusPx) : grow;
+}
+
 export class OrbitCamera {
   private target: Vec3 = [0, 20, 0];
   private yaw = 0;  // radians around +y; 0 looks along -z
@@ -93,7 +99,8 @@ export class OrbitCamera {
             this.target[2] + Math.cos(this.yaw) * c * this.distance];
   }
 
-  viewProjection(aspect: number): Mat4 {
+  viewProjection(canvasAspect: number): Mat4 {
+    const aspect = canvasAspect > 0 && Number.isFinite(canvasAspect) ? canvasAspect : 1;  // a canvas of no size
     // A tall canvas (a phone held upright) widens the vertical field, so that
     // the horizontal one stays FOV and the tank still fits across.
     const fovY = aspect >= 1 ? FOV : 2 * Math.atan(Math.tan(FOV / 2) / aspect);

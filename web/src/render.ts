@@ -8,7 +8,7 @@
 // dequantises over the tank and looks up radius and colour by kind, so no
 // per-ball work is done in JavaScript and no matrix exists per ball.
 
-import { radiusOnScreen, type Mat4, type Vec3 } from './camera';
+import { outlineGrow, radiusOnScreen, type Mat4, type Vec3 } from './camera';
 import type { Pair, Player } from './snapshots';
 
 export interface BallKind {
@@ -22,6 +22,9 @@ const OUTLINE_GROW = 1.35;
 const OUTLINE_MIN_PX = 8;  // CSS pixels: the ring's outer radius at least, so that a distant sphere is found
 const OUTLINE_COLOUR: Vec3 = [1.0, 0.72, 0.1];
 const HIDDEN_ALPHA = 0.8;  // the own sphere's amber over the balls in front of it
+// The hidden pass takes its depth from a sphere a tenth larger than the own one: just in front of its
+// surface, so that where the sphere is in view, the amber never ties with it in the depth test.
+const HIDDEN_DEPTH_GROW = 1.1;
 const CLEAR: [number, number, number] = [0.055, 0.066, 0.09];
 
 // One fixed light from above and in front of the default camera, plus ambient so
@@ -65,6 +68,7 @@ layout(location = 0) in vec3 a_unit;
 layout(location = 1) in vec3 i_centre;
 uniform mat4 u_view_proj;
 uniform float u_radius;
+uniform float u_depth_radius;
 uniform vec3 u_colour;
 out vec3 v_normal;
 out vec3 v_colour;
@@ -72,6 +76,11 @@ void main() {
   v_normal = a_unit;
   v_colour = u_colour;
   gl_Position = u_view_proj * vec4(i_centre + a_unit * u_radius, 1.0);
+  // The hidden pass: the ring's size at the sphere's own depth, so that what hides the sphere turns amber.
+  if (u_depth_radius != u_radius) {
+    vec4 at = u_view_proj * vec4(i_centre + a_unit * u_depth_radius, 1.0);
+    gl_Position.z = at.z / at.w * gl_Position.w;
+  }
 }`;
 
 // Blended over the scene so the lines stay faint against balls and background.
@@ -152,7 +161,7 @@ export class Renderer {
     this.players = compile(gl, PLAYER_VERTEX, FRAGMENT);
     this.lines = compile(gl, LINE_VERTEX, LINE_FRAGMENT);
     this.ballU = uniforms(gl, this.balls, ['u_view_proj', 'u_tank_min', 'u_quantum', 'u_alpha', 'u_kinds', 'u_unlit']);
-    this.playerU = uniforms(gl, this.players, ['u_view_proj', 'u_radius', 'u_colour', 'u_unlit']);
+    this.playerU = uniforms(gl, this.players, ['u_view_proj', 'u_radius', 'u_depth_radius', 'u_colour', 'u_unlit']);
     this.lineU = uniforms(gl, this.lines, ['u_view_proj']);
 
     const mesh = uvSphere(12, 12);
@@ -235,25 +244,29 @@ export class Renderer {
       gl.uniformMatrix4fv(this.playerU.u_view_proj, false, viewProj);
       gl.bindVertexArray(this.playerVao);
       gl.uniform1f(this.playerU.u_radius, PLAYER_RADIUS);
+      gl.uniform1f(this.playerU.u_depth_radius, PLAYER_RADIUS);
       gl.uniform3fv(this.playerU.u_colour, [1, 1, 1]);
       gl.uniform1i(this.playerU.u_unlit, 0);
       gl.drawElementsInstanced(gl.TRIANGLES, this.indexCount, gl.UNSIGNED_SHORT, 0, players.length);
       if (ownIndex >= 0) {
         // The inside of a larger, unlit sphere: a ring around the silhouette.
         const own = players[ownIndex].pos;
-        const radiusPx = radiusOnScreen(viewProj, own, PLAYER_RADIUS, gl.drawingBufferHeight);
-        const minPx = OUTLINE_MIN_PX * (window.devicePixelRatio || 1);
-        const grow = radiusPx > 0 ? Math.max(OUTLINE_GROW, minPx / radiusPx) : OUTLINE_GROW;
+        // Device pixels per CSS pixel of the drawing buffer, which the browser may keep smaller than asked.
+        const scale = gl.drawingBufferHeight / Math.max(1, (gl.canvas as HTMLCanvasElement).clientHeight);
+        const grow = outlineGrow(radiusOnScreen(viewProj, own, PLAYER_RADIUS, gl.drawingBufferHeight),
+                                 OUTLINE_MIN_PX * scale, OUTLINE_GROW);
         gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(own), gl.DYNAMIC_DRAW);
         gl.uniform1f(this.playerU.u_radius, PLAYER_RADIUS * grow);
+        gl.uniform1f(this.playerU.u_depth_radius, PLAYER_RADIUS * grow);
         gl.uniform3fv(this.playerU.u_colour, OUTLINE_COLOUR);
         gl.uniform1i(this.playerU.u_unlit, 1);
         gl.cullFace(gl.FRONT);
         gl.drawElementsInstanced(gl.TRIANGLES, this.indexCount, gl.UNSIGNED_SHORT, 0, 1);
         gl.cullFace(gl.BACK);
-        // Where balls hide it (the sphere starts amid the pour), the sphere at the ring's size
-        // again, amber and blended over them: only the depth test's GREATER passes, so what is
-        // in view stays as drawn.
+        // Where balls hide it (the sphere starts amid the pour), a disc of the ring's size at the
+        // sphere's own depth, amber and blended over them: only the depth test's GREATER passes,
+        // so what is in view stays as drawn.
+        gl.uniform1f(this.playerU.u_depth_radius, PLAYER_RADIUS * HIDDEN_DEPTH_GROW);
         gl.depthFunc(gl.GREATER);
         gl.depthMask(false);
         gl.enable(gl.BLEND);
