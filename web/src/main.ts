@@ -33,10 +33,17 @@ canvas.addEventListener('webglcontextlost', (e) => {
   renderer = null;
 });
 canvas.addEventListener('webglcontextrestored', () => {
-  renderer = new Renderer(gl!);
+  try {
+    renderer = new Renderer(gl!);
+  } catch (e) {
+    // Lost again while compiling: the next restore tries again; anything else will not mend itself.
+    if (!gl!.isContextLost()) restoreProblem = `The page could not draw again after losing its WebGL context (${e}): reload it.`;
+    return;
+  }
   kindsOf = null;  // the new renderer is told the kinds again
   contextLost = false;
 });
+let restoreProblem = '';
 const CONTEXT_LOST = 'The GPU took this page\'s drawing away (WebGL context lost): it draws again once the browser gives it back.';
 const overlay = document.getElementById('overlay')!;
 const input = new Input(canvas, overlay);
@@ -114,7 +121,7 @@ function frame(nowMs: number): void {
     fpsStarted = nowMs;
   }
   hud.update(net, { fps, frameMs, now, renderDelayMs: 1000 * net.snapshots.renderDelay(), observerAsked,
-                    webgl: contextLost ? CONTEXT_LOST : webglProblem });
+                    webgl: restoreProblem || (contextLost ? CONTEXT_LOST : webglProblem) });
   requestAnimationFrame(frame);
 }
 requestAnimationFrame(frame);
