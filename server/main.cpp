@@ -95,11 +95,14 @@ int run_bench(const fishtank::ServerOptions& o) {
   // becomes what the scene holds where that is fewer.
   fishtank::BenchSpec bench = o.bench_spec;
   const std::string& scene = bench.scene.name;
-  if (const std::uint32_t holds = fishtank::scene_capacity(world, scene); bench.scene.balls > holds) {
+  const std::uint32_t capacity = fishtank::scene_capacity(world, scene);
+  const bool capped = o.max_balls > 0 && o.max_balls < capacity;  // --max-balls bounds every scene
+  if (const std::uint32_t holds = capped ? o.max_balls : capacity; bench.scene.balls > holds) {
     if (o.balls_given) {
-      std::cerr << "fishtank-server: --bench refuses --balls " << bench.scene.balls << ": the " << scene
-                << (scene == "tank" ? "" : " scene") << " holds at most " << holds << "; use --balls " << holds
-                << " or fewer, or --scene wide for more\n";
+      std::cerr << "fishtank-server: --bench refuses --balls " << bench.scene.balls << ": "
+                << (capped ? "--max-balls lets in" : "the " + scene + (scene == "tank" ? "" : " scene") + " holds")
+                << " at most " << holds << "; use --balls " << holds << " or fewer"
+                << (capped ? "" : ", or --scene wide for more") << "\n";
       return 2;
     }
     bench.scene.balls = holds;

@@ -1,12 +1,17 @@
 #include "server/scenes/active_scene.h"
 
+#include <algorithm>
+
 namespace fishtank {
+
+std::uint32_t ActiveScene::asked_balls() const { return choice_.balls.value_or(default_balls(choice_.name)); }
 
 SceneSpec ActiveScene::spec() const {
   SceneSpec spec;
   spec.name = choice_.name;
   spec.seed = choice_.seed;
-  spec.balls = choice_.balls.value_or(default_balls(choice_.name));
+  // --max-balls bounds every scene, not only what AddBalls pours in; the wide scene's tank is sized for it.
+  spec.balls = choice_.max_balls > 0 ? std::min(asked_balls(), choice_.max_balls) : asked_balls();
   return spec;
 }
 
@@ -21,15 +26,12 @@ std::string ActiveScene::start(World& world, const std::optional<std::string>& s
   if (choice_.max_balls > 0)
     if (const std::string refusal = world.set_max_balls(choice_.max_balls); !refusal.empty())
       limit_note_ = "scene " + choice_.name + ": --max-balls: " + refusal + "; the tank's capacity is the limit";
-  std::string refusal;
-  SceneSpec placed = s;
-  // --max-balls bounds every scene, not only what AddBalls pours in.
-  if (choice_.max_balls > 0 && placed.balls > choice_.max_balls) {
-    placed.balls = choice_.max_balls;
-    refusal = "the " + s.name + " scene: --max-balls lets in " + std::to_string(placed.balls) + " of the " +
-              std::to_string(s.balls) + " balls asked for";
+  std::string refusal = populate(world, s);
+  if (const std::uint32_t asked = asked_balls(); s.balls < asked) {
+    const std::string cap =
+        "--max-balls lets in " + std::to_string(s.balls) + " of the " + std::to_string(asked) + " balls asked for";
+    refusal = refusal.empty() ? "the " + s.name + " scene: " + cap : refusal + " (" + cap + ")";
   }
-  if (std::string fewer = populate(world, placed); !fewer.empty()) refusal = fewer;
   world.respawn_players();
   ++starts_;
   return refusal;

@@ -38,6 +38,8 @@ class ActiveScene {
   std::uint32_t start_count() const { return starts_; }
 
  private:
+  std::uint32_t asked_balls() const;  // --balls, or the scene's default
+
   SceneSpec spec() const;
 
   SceneChoice choice_;

@@ -50,6 +50,19 @@ def test_bench_on_a_scene_that_holds_fewer_says_what_it_holds_and_that_count_run
     assert json.loads(default.stdout)["balls"] == int(holds.group(1))
 
 
+def test_bench_keeps_to_max_balls_on_a_placed_scene_too():
+    run = subprocess.run([SERVER, "--bench", "--scene", "wide", "--balls", "1000", "--max-balls", "500"],
+                         capture_output=True, text=True, timeout=30)
+    assert run.returncode == 2 and run.stdout == ""
+    assert run.stderr.strip() == ("fishtank-server: --bench refuses --balls 1000: --max-balls lets in at most 500; "
+                                  "use --balls 500 or fewer"), run.stderr
+    quick = ["--steps", "10", "--windows", "1", "--settle-time", "0.05"]
+    default = subprocess.run([SERVER, "--bench", "--scene", "wide", "--max-balls", "500", *quick],
+                             capture_output=True, text=True, timeout=120)
+    assert default.returncode == 0, default.stderr
+    assert json.loads(default.stdout)["balls"] == 500  # the benchmark's 6000 becomes what --max-balls lets in
+
+
 def test_a_port_in_use_names_the_flag_and_port_0_and_no_banner_comes_first():
     first = subprocess.Popen([SERVER, "--port", "0", "--threads", "1", "--duration", "30"],
                              stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True)
