@@ -161,7 +161,8 @@ void run_rows(const Options& o) {
   std::printf("\nmulti-contact rows: largest final velocity error / approach speed\n");
   for (int balls : {2, 3, 5})
     for (int n : {10, 13, 20, 28, 40, 56, 80}) {
-      const double error = row_error(Row{balls, 2.5e4, 0.6, 1.0}, *o.kernels, n);
+      const double error =
+          row_error(Row{balls, PhysicsParams{}.stiffness, PhysicsParams{}.restitution, 1.0}, *o.kernels, n);
       csv << balls << ',' << n << ',' << error << '\n';
       std::printf("  %d balls, n = %2d: %.3e\n", balls, n, error);
     }
