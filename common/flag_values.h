@@ -38,10 +38,16 @@ inline std::string flag_error_text(const boost::program_options::error& e,
   const po::option_description* option = name.rfind("--", 0) == 0 ? flags.find_nothrow(name.substr(2), false) : nullptr;
   if (!option) return e.what();
   const po::value_semantic* semantic = option->semantic().get();
-  if (detail::holds_one_of<int, unsigned, long, unsigned long, long long, unsigned long long>(semantic))
-    return std::string(e.what()) + ": it takes a whole number";
-  if (detail::holds_one_of<float, double>(semantic)) return std::string(e.what()) + ": it takes a number";
-  return e.what();
+  const std::string text = e.what();
+  if (detail::holds_one_of<int, unsigned, long, unsigned long, long long, unsigned long long>(semantic)) {
+    // Boost quotes the value as ('...'); one of digits alone is a whole number too large to hold.
+    const std::size_t from = text.find("('") + 2, to = text.find("')");
+    const bool digits =
+        from >= 2 && to != std::string::npos && to > from && text.find_first_not_of("+-0123456789", from) >= to;
+    return text + (digits ? ": that number is far too large" : ": it takes a whole number");
+  }
+  if (detail::holds_one_of<float, double>(semantic)) return text + ": it takes a number";
+  return text;
 }
 
 }  // namespace fishtank
