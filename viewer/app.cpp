@@ -38,8 +38,8 @@ constexpr int kWindowHeight = 1024;
 constexpr float kPlayerSpeed = 8.0f;  // m/s; the server clamps at its own maximum
 constexpr std::uint32_t kBallsPerPress = 1000;
 constexpr float kOutlineGrow = 1.35f;
-constexpr float kOutlineMinPixels =
-    8.0f;  // the ring's outer radius at least, so that a distant sphere is found
+// The ring's outer radius at least, in logical pixels, so that a distant sphere is found.
+constexpr float kOutlineMinPixels = 8.0f;
 const std::array<std::uint8_t, 4> kOutlineRgba{255, 176, 32, 255};
 constexpr float kHiddenAlpha = 0.8f;  // the own sphere's amber over the balls in front of it
 

@@ -27,6 +27,8 @@ const webglProblem = gl ? '' : 'This browser gives the page no WebGL2 context: n
 // A GPU reset, or a phone reclaiming memory from a tab in the background, takes
 // the context and everything made in it; preventDefault asks for it back.
 let contextLost = false;
+let restoreProblem = '';  // why the page could not draw again after a restore
+const CONTEXT_LOST = 'The GPU took this page\'s drawing away (WebGL context lost): it draws again once the browser gives it back.';
 canvas.addEventListener('webglcontextlost', (e) => {
   e.preventDefault();
   contextLost = true;
@@ -43,8 +45,6 @@ canvas.addEventListener('webglcontextrestored', () => {
   kindsOf = null;  // the new renderer is told the kinds again
   contextLost = false;
 });
-let restoreProblem = '';
-const CONTEXT_LOST = 'The GPU took this page\'s drawing away (WebGL context lost): it draws again once the browser gives it back.';
 const overlay = document.getElementById('overlay')!;
 const input = new Input(canvas, overlay);
 const camera = new OrbitCamera();
