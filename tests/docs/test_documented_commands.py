@@ -7,7 +7,8 @@ Each runs from a scratch folder (so what it writes lands there) with these
 rewrites, which keep it a few seconds long and off other people's ports:
 - build/, scripts/ and docs/ are this checkout's (FISHTANK_BUILD_DIR for build/);
   a program quoted by name alone is build/'s;
-- servers run on --port 0 for --duration 1 at most (a trailing & is dropped);
+- servers run on --port 0 (and --no-web unless a web port is given) for --duration 1 at most (a trailing
+  & is dropped);
 - clients, viewers and Python examples go to a fresh server of 300 balls on one
   thread, for 1 s at most; a viewer runs under xvfb-run; otherhost is 127.0.0.1;
 - benchmarks time small scenes: --balls 60 (10 000, the least, for wide), --steps 200 at most;
@@ -115,6 +116,8 @@ def rewrite_program(words, port):
             cap_flag(words, "--steps", 200)
         elif "--help" not in words:
             set_flag(words, "--port", "0")
+            if "--web-port" not in words and "--no-web" not in words:
+                words.append("--no-web")  # the default web port 8080 may be taken (a server the reader runs)
             set_flag(words, "--threads", "1")
             limit_duration(words)
     elif name in ("fishtank-client", "fishtank-viewer"):
@@ -164,9 +167,9 @@ def prepare(command, port, lammps_dir):
 def lammps_dir(tmp_path_factory):
     """A small scene exported for LAMMPS: what DIR stands for."""
     folder = tmp_path_factory.mktemp("lammps") / "scene"
-    subprocess.run([str(program("fishtank-server")), "--port", "0", "--threads", "1", "--balls", "300", "--duration",
-                    "1", "--export-lammps", str(folder), "--lammps-steps", "200"], check=True, capture_output=True,
-                   timeout=60)
+    subprocess.run([str(program("fishtank-server")), "--port", "0", "--no-web", "--threads", "1", "--balls", "300",
+                    "--duration", "1", "--export-lammps", str(folder), "--lammps-steps", "200"], check=True,
+                   capture_output=True, timeout=60)
     return folder
 
 

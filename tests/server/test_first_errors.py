@@ -64,7 +64,7 @@ def test_bench_keeps_to_max_balls_on_a_placed_scene_too():
 
 
 def test_a_port_in_use_names_the_flag_and_port_0_and_no_banner_comes_first():
-    first = subprocess.Popen([SERVER, "--port", "0", "--threads", "1", "--duration", "30"],
+    first = subprocess.Popen([SERVER, "--port", "0", "--no-web", "--threads", "1", "--duration", "30"],
                              stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True)
     try:
         port = None
@@ -73,7 +73,7 @@ def test_a_port_in_use_names_the_flag_and_port_0_and_no_banner_comes_first():
             found = re.match(r"listening on 127\.0\.0\.1:(\d+)", first.stderr.readline())
             port = found and found.group(1)
         assert port, "the first server did not start"
-        second = subprocess.run([SERVER, "--port", port, "--threads", "1"], capture_output=True, text=True,
+        second = subprocess.run([SERVER, "--port", port, "--no-web", "--threads", "1"], capture_output=True, text=True,
                                 timeout=30)
     finally:
         first.send_signal(signal.SIGTERM)
