@@ -164,7 +164,8 @@ TEST_CASE("abuse: 500 peers say Hello, announce 1 MiB, send one byte and stall -
     std::this_thread::sleep_for(1500ms);
   });
   const long growth = rss_growth_kb(server, rss_before);
-  CHECK_THAT(server.log(), Catch::Contains("client 501 connected"));  // all held, none refused
+  // All held, none refused; the server may still be accepting the last of them from its backlog.
+  CHECK(wait_for_log(server, "client 501 connected", 10s) < 10.0);
   record("500 peers say Hello, announce a 1 MiB frame, send 1 byte of it and stall",
          "frame buffer grows with the bytes received",
          "all held; RSS +" + fixed(growth / 1024.0, "MiB") + " (" + fixed(growth / 500.0, "kB") + " a peer)", rate);
@@ -284,7 +285,8 @@ void check_observer_among_stalled_peers(bool web) {
   for (int i = 0; i < 5; ++i) peers.push_back(std::make_unique<RawSocket>(port));
   const Clock::time_point connected = Clock::now();
   BackgroundClient observer(server.port(), false, "observer");
-  const bool welcomed = observer.wait_until([](const ClientState& s) { return s.welcomed; }, 1s);
+  // The time is recorded for the abuse table; 5 s of grace keeps a busy or sanitised build from failing.
+  const bool welcomed = observer.wait_until([](const ClientState& s) { return s.welcomed; }, 5s);
   const double welcome_s = seconds_since(connected);
   const double rate = snapshot_rate(observer, [] { std::this_thread::sleep_for(1s); });
   const long growth = rss_growth_kb(server, rss_before);
@@ -334,7 +336,7 @@ TEST_CASE("abuse: a Hello sent one byte at a time is cut off at the Hello deadli
          "closed after " + fixed(seconds, "s") + " with " + first_error_code(got), rate);
   CHECK(closed);
   CHECK(first_error_code(got) == "hello_timeout");
-  CHECK(seconds < 3.0);
+  CHECK(seconds < 5.0);  // the deadline is 1 s; sent whole at this pace the Hello would take many
   CHECK(rate >= kHonestRate);
 }
 
