@@ -47,7 +47,7 @@ def frames_as_written(path):
 
 def test_a_pour_recorded_from_t0_opens_in_ase_frame_by_frame_and_ends_at_the_dumped_state(tmp_path):
     balls = 400  # more than one spawn round's worth, so the count grows between frames
-    trajectory, final, _ = record(tmp_path, "--balls", str(balls), "--duration", "2", "--record-every", "50")
+    trajectory, final, _ = record(tmp_path, "--balls", str(balls), "--duration", "3", "--record-every", "50")
     written = frames_as_written(trajectory)
     images = ase_io.read(str(trajectory), index=":", format="lammps-dump-text")
 
@@ -71,7 +71,7 @@ def test_a_pour_recorded_from_t0_opens_in_ase_frame_by_frame_and_ends_at_the_dum
 
 def test_a_settled_tank_recorded_with_a_constant_count_opens_in_mdanalysis_with_velocities_and_box(tmp_path):
     balls, every, start = 100, 100, 3.5  # e = 0.1: at rest on the floor about 3.2 s after the start
-    trajectory, final, log = record(tmp_path, "--balls", str(balls), "--restitution", "0.1", "--duration", "4.5",
+    trajectory, final, log = record(tmp_path, "--balls", str(balls), "--restitution", "0.1", "--duration", "5",
                                     "--record-from", str(start), "--record-constant-count", "--record-every",
                                     str(every))
     dt = float(re.search(r"dt = (\S+) s", log).group(1))  # printed to 3 significant digits

@@ -32,6 +32,9 @@ timeout 200 xvfb-run -a -s "-screen 0 1280x1024x24" bash -euo pipefail -c '
   }
   window=$(xdotool search --sync --name Fishtank | head -n 1)
   for _ in $(seq 200); do grep -q "welcomed with player sphere" "$SERVER_LOG" && break; sleep 0.1; done
+  # The viewer ignores sandbox keys until it has a snapshot: deltas (frames sent, no keyframe) mean it
+  # acknowledged one.
+  for _ in $(seq 200); do grep -q "[1-9][0-9]* B mean, 0 keyframes" "$SERVER_LOG" && break; sleep 0.1; done
   xdotool windowfocus "$window"
   xdotool key bracketleft
   expect_status "time scale set to x0.50" "[ slows the clock to 0.5"

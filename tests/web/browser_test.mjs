@@ -166,10 +166,14 @@ test('pressed under the pile (Q), the page\'s own sphere shows through the balls
 
 test('holding D moves the player sphere to the camera\'s right (+x at the start)', async () => {
   const start = own(await waitForState(page, (st) => own(st), 'the own player'));
+  // Held until the move shows: a software-rendered page on a busy machine can be slow to send its input.
   await page.keyboard.down('KeyD');
-  await sleep(800);
-  await page.keyboard.up('KeyD');
-  const moved = own(await waitForState(page, (st) => own(st).pos[0] > start.pos[0] + 2, 'the player moved 2 m along +x'));
+  let moved;
+  try {
+    moved = own(await waitForState(page, (st) => own(st).pos[0] > start.pos[0] + 2, 'the player moved 2 m along +x'));
+  } finally {
+    await page.keyboard.up('KeyD');
+  }
   assert.ok(Math.abs(moved.pos[2] - start.pos[2]) < 0.5, `not along z: ${JSON.stringify([start, moved])}`);
 });
 
@@ -249,15 +253,20 @@ test('two tabs see one world: each sees the other\'s player, and one tab\'s move
 });
 
 test('a page hidden over two seconds asks for no snapshots, and shown again decodes the world without asking for a keyframe', async () => {
+  // Returns the page's clock at the change.
   const setVisibility = (p, state) => p.evaluate((s) => {
     Object.defineProperty(document, 'visibilityState', { get: () => s, configurable: true });
     document.dispatchEvent(new Event('visibilitychange'));
+    return performance.now();
   }, state);
   await page.bringToFront();
   const shown = await waitForState(page, (st) => st.connection === 'connected' && st.watching, 'a watching page');
-  await setVisibility(page, 'hidden');
+  const hiddenAt = await setVisibility(page, 'hidden');
   await sleep(1000);
-  assert.equal((await waitForState(page, () => true, 'state')).watching, true, 'a glance away keeps the snapshots');
+  // Read with the time since the page was hidden: a busy main thread may answer only after the 2 s grace.
+  const glance = await page.evaluate((t0) => ({ watching: window.fishtank.state().watching, ms: performance.now() - t0 }),
+    hiddenAt);
+  if (glance.ms < 1900) assert.equal(glance.watching, true, `a glance away keeps the snapshots: ${JSON.stringify(glance)}`);
   const off = await waitForState(page, (st) => !st.watching, 'watching off after the grace');
   // Snapshots already on their way still arrive: wait for a quiet half second (a busy machine may take longer).
   let quiet = await waitForState(page, () => true, 'state');
