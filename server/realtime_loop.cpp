@@ -1,5 +1,6 @@
 #include "server/realtime_loop.h"
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 
@@ -14,9 +15,36 @@ constexpr double kMaxLagSeconds = 0.05;
 // to be scheduled, well inside the pool's 1 ms of polling.
 constexpr double kWakeLeadSeconds = 0.0003;
 
+// The rates snapshots carry are measured over at most this long, whatever the
+// status line's interval: a viewer's figures must not wait for a long one.
+constexpr double kLiveWindowSeconds = 1.0;
+
 double seconds_between(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double>(to - from).count();
 }
+
+// Steps and busy time since `start`, turned into a status's rates once `length` has passed.
+struct RateWindow {
+  Clock::time_point start;
+  double length;
+  std::uint64_t steps = 0;
+  double busy = 0.0;
+
+  void add(std::uint64_t batch_steps, double batch_busy) {
+    steps += batch_steps;
+    busy += batch_busy;
+  }
+  // Whether it has ended at `end`; then its rates are written into status and it starts again.
+  bool close(Clock::time_point end, double dt, LoopStatus& status) {
+    const double span = seconds_between(start, end);
+    if (span < length) return false;
+    status.steps_per_s = steps / span;
+    status.load = busy / span;
+    status.time_scale = steps * dt / span;
+    *this = {end, length};
+    return true;
+  }
+};
 }  // namespace
 
 TunedStepper::TunedStepper(World& world, bool tune) : world_(world), epoch_(Clock::now()) {
@@ -52,10 +80,9 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
   RunControl& control = options.control ? *options.control : real_time;
   const Clock::time_point start = Clock::now();
   double sim_clock = 0.0;  // the wall time by which the steps done so far were due
-  LoopStatus status;
-  Clock::time_point window_start = start;
-  std::uint64_t window_steps = 0;
-  double window_busy = 0.0;
+  LoopStatus status;       // what at_step_boundary sees: rates of the latest live window
+  RateWindow live{start, std::min(options.status_interval, kLiveWindowSeconds)};
+  RateWindow line{start, options.status_interval};
 
   while (!stop.load(std::memory_order_relaxed)) {
     const double now = seconds_between(start, Clock::now());
@@ -66,9 +93,11 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
     const double wall_per_step = dt / control.time_scale;
     if (control.paused) {
       sim_clock = now;
-    } else if (now - sim_clock > kMaxLagSeconds) {
-      status.dropped_steps += static_cast<std::uint64_t>((now - sim_clock - kMaxLagSeconds) / wall_per_step);
-      sim_clock = now - kMaxLagSeconds;
+    } else if (now - sim_clock > std::max(kMaxLagSeconds, wall_per_step)) {
+      // A step longer than the lag allowed (a soft k, a slowed clock) must still come due.
+      const double max_lag = std::max(kMaxLagSeconds, wall_per_step);
+      status.dropped_steps += static_cast<std::uint64_t>((now - sim_clock - max_lag) / wall_per_step);
+      sim_clock = now - max_lag;
     }
     // Steps are due up to `now`, but the batch stops at its budget so that
     // snapshots, status and commands keep their rate whatever a step costs.
@@ -85,33 +114,33 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
     }
     const Clock::time_point busy_end = Clock::now();
     const double busy = seconds_between(busy_start, busy_end);
-    window_busy += busy;
-    window_steps += batch_steps;
+    live.add(batch_steps, busy);
+    line.add(batch_steps, busy);
     status.threads = stepper.threads();
     status.crowding_cores = stepper.crowding_cores();
-
-    const double window = seconds_between(window_start, busy_end);
-    if (window >= options.status_interval) {
-      status.steps_per_s = window_steps / window;
-      status.load = window_busy / window;
-      status.time_scale = window_steps * dt / window;
-      if (options.on_status) options.on_status(world, status);
-      window_start = busy_end;
-      window_steps = 0;
+    live.close(busy_end, dt, status);
+    LoopStatus line_status = status;
+    if (line.close(busy_end, dt, line_status)) {
+      if (options.on_status) options.on_status(world, line_status);
       status.dropped_steps = 0;
-      window_busy = 0.0;
     }
     if (control.paused && control.steps_to_run > 0) continue;  // asked-for steps run back to back
     // Sleep until a batch of steps is due rather than a single one, and wake
     // the worker threads a little before it: waking a sleeping thread costs
-    // more than the batch would otherwise wait for.
+    // more than the batch would otherwise wait for. However far off the next
+    // step is, the loop comes round every batch_seconds (commands, snapshots,
+    // the status line, stop).
+    const double after = seconds_between(start, Clock::now());
     const double next_batch = sim_clock + std::max(wall_per_step, options.batch_seconds);
-    const double wait = next_batch - seconds_between(start, Clock::now());
+    const double next_round = after + options.batch_seconds;
+    const bool batch_due = !control.paused && next_batch <= next_round;
+    const double wake_at = batch_due ? next_batch : next_round;
+    const double wait = wake_at - after;
     if (wait > kWakeLeadSeconds) std::this_thread::sleep_for(std::chrono::duration<double>(wait - kWakeLeadSeconds));
-    world.wake_workers();
+    if (batch_due) world.wake_workers();
     if (wait > 0.0)
       std::this_thread::sleep_until(
-          start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(next_batch)));
+          start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(wake_at)));
   }
 }
 

@@ -42,14 +42,16 @@ class TunedStepper {
   std::uint64_t one_thread_steps_ = 0;
 };
 
+// Its rates (steps_per_s, load, time_scale) cover the last status interval in
+// on_status, and the last second (or the interval, if shorter) in at_step_boundary.
 struct LoopStatus {
   double steps_per_s = 0.0;
   int threads = 1;                  // worker threads the steps use now (see ThreadTuner)
   double crowding_cores = -1.0;     // cores work in other sessions keeps busy; below 0 unknown
   double load = 0.0;                // 0..1: time spent stepping / wall time
   std::uint64_t dropped_steps = 0;  // steps skipped because the machine fell behind, in the last interval
-  // Simulated seconds per wall second over the last interval: below 1 the
-  // physics cannot keep real time and the world runs in slow motion.
+  // Simulated seconds per wall second: below 1 the physics cannot keep real
+  // time and the world runs in slow motion.
   double time_scale = 1.0;
 };
 

@@ -3,7 +3,9 @@
 // motion and says so, and one within it keeps real time. People's controls:
 // a paused loop steps only what is asked and keeps calling back, and a time
 // scale set below 1 slows simulated time by that much, without reading as
-// an overload.
+// an overload. However far apart steps come (soft contacts, a slow clock)
+// they come, and the loop still calls back at its rate; the rates it passes
+// between batches cover the last second, whatever the status interval.
 
 #include "server/realtime_loop.h"
 
@@ -21,18 +23,23 @@ namespace {
 
 struct Observed {
   double boundaries_per_s = 0.0;  // at_step_boundary calls, where snapshots go out
+  LoopStatus last_boundary;       // what the last of them saw
   std::vector<double> time_scales;
   double sim_seconds = 0.0;
+  double wall_seconds = 0.0;
 };
 
-Observed run_paced(World& world, double seconds, RunControl* control = nullptr) {
+Observed run_paced(World& world, double seconds, RunControl* control = nullptr, double status_interval = 0.25) {
   LoopOptions options;
   options.control = control;
   options.duration = seconds;
-  options.status_interval = 0.25;
+  options.status_interval = status_interval;
   Observed seen;
   int boundaries = 0;
-  options.at_step_boundary = [&](World&, const LoopStatus&) { ++boundaries; };
+  options.at_step_boundary = [&](World&, const LoopStatus& s) {
+    ++boundaries;
+    seen.last_boundary = s;
+  };
   options.on_status = [&](const World&, const LoopStatus& s) { seen.time_scales.push_back(s.time_scale); };
   const double sim_before = world.time();
   const auto start = std::chrono::steady_clock::now();
@@ -41,6 +48,7 @@ Observed run_paced(World& world, double seconds, RunControl* control = nullptr) 
   run_realtime(stepper, options, stop);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   seen.boundaries_per_s = boundaries / wall;
+  seen.wall_seconds = wall;
   seen.sim_seconds = world.time() - sim_before;
   return seen;
 }
@@ -110,4 +118,40 @@ TEST_CASE("a time scale of one half advances half the simulated time, and is not
   CHECK(seen.time_scales.back() == Approx(0.5).margin(0.06));
   CHECK_FALSE(slow_motion(seen.time_scales.back(), control.time_scale));
   CHECK(slow_motion(seen.time_scales.back()));  // against real time it is slower
+}
+
+TEST_CASE("a step due later than the loop lets lag accrue still comes: soft contacts at a tenth of real time",
+          "[server][loop]") {
+  // k = 1000 N/m: dt = 5.4 ms, 54 ms of wall time a step at x0.1, more than the 50 ms of lag caught up on.
+  World world(with_stiffness(1000.0f), kSseKernels, 1, 5);
+  place_lattice(world, 100);
+  RunControl control;
+  control.time_scale = 0.1;
+  const Observed seen = run_paced(world, 1.5, &control);
+  INFO("dt " << world.dt() << " s, " << world.steps() << " steps");
+  CHECK(seen.sim_seconds == Approx(0.15).margin(0.03));
+  CHECK(seen.boundaries_per_s >= 30.0);
+}
+
+TEST_CASE("steps seconds apart leave the loop calling back at its rate and stopping on time", "[server][loop]") {
+  // k = 1 N/m: dt = 0.17 s, 1.7 s of wall time a step at x0.1.
+  World world(with_stiffness(1.0f), kSseKernels, 1, 5);
+  place_lattice(world, 100);
+  RunControl control;
+  control.time_scale = 0.1;
+  const Observed seen = run_paced(world, 0.5, &control);
+  INFO("dt " << world.dt() << " s");
+  CHECK(seen.boundaries_per_s >= 30.0);  // commands, snapshots and stop are not kept waiting for the step
+  CHECK(seen.wall_seconds < 1.0);
+}
+
+TEST_CASE("the rates seen between batches cover the last second, however far apart the status lines are",
+          "[server][loop]") {
+  World world(with_stiffness(25000.0f), kSseKernels, 1, 5);
+  place_lattice(world, 100);
+  const Observed seen = run_paced(world, 2.5, nullptr, /*status_interval=*/60.0);
+  CHECK(seen.time_scales.empty());  // no status line yet
+  CHECK(seen.last_boundary.steps_per_s == Approx(1.0 / world.dt()).epsilon(0.1));
+  CHECK(seen.last_boundary.time_scale == Approx(1.0).margin(0.1));
+  CHECK(seen.last_boundary.load > 0.0);
 }
