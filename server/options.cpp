@@ -119,7 +119,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
 
   po::options_description physics("Physics");
   physics.add_options()("stiffness", po::value(&o.physics.stiffness)->default_value(defaults.stiffness, "25000"),
-                        "contact spring constant k, N/m")(
+                        "contact spring constant k, N/m, at least 785 (softer piles sink through the floor)")(
       "restitution", po::value(&o.physics.restitution)->default_value(defaults.restitution, "0.6"),
       "coefficient of restitution e, (0, 1]")(
       "tolerance", po::value(&o.physics.tolerance)->default_value(defaults.tolerance, "0.005"),

@@ -8,7 +8,9 @@ namespace fishtank {
 
 namespace {
 constexpr float kPi = 3.14159265358979f;
-}
+// Softer, even without gravity, a contact lasts over 2 s: steps too far apart to watch.
+constexpr float kSoftestStiffness = 1.0f;
+}  // namespace
 
 float damping_ratio(float restitution) {
   float ln_e = std::log(restitution);
@@ -22,6 +24,13 @@ float smallest_effective_mass() {
 }
 
 float contact_duration(float stiffness) { return kPi * std::sqrt(smallest_effective_mass() / stiffness); }
+
+float softest_stiffness(const PhysicsParams& p) {
+  const BallKind& heaviest =
+      *std::max_element(kBallKinds.begin(), kBallKinds.end(), [](auto& a, auto& b) { return a.mass < b.mass; });
+  const float column_weight = p.tank.size().y / heaviest.diameter * heaviest.mass * std::fabs(p.gravity);
+  return column_weight / (0.5f * kMinBallDiameter);
+}
 
 int steps_for_tolerance(float tolerance) {
   return static_cast<int>(std::ceil(std::sqrt(PhysicsParams::kToleranceRule / tolerance) - 1e-4f));
@@ -37,8 +46,8 @@ float derived_dt(const PhysicsParams& p) {
 
 std::string validate(const PhysicsParams& p) {
   std::ostringstream err;
-  if (!std::isfinite(p.stiffness) || p.stiffness <= 0.0f || p.stiffness > 1.0e9f)
-    err << "stiffness k must be in (0, 1e9] N/m, got " << p.stiffness;
+  if (!std::isfinite(p.stiffness) || p.stiffness < kSoftestStiffness || p.stiffness > 1.0e9f)
+    err << "stiffness k must be in [" << kSoftestStiffness << ", 1e9] N/m, got " << p.stiffness;
   else if (!std::isfinite(p.restitution) || p.restitution <= 0.0f || p.restitution > 1.0f)
     err << "restitution e must be in (0, 1], got " << p.restitution;
   else if (!std::isfinite(p.tolerance) || p.tolerance < PhysicsParams::kTightestTolerance ||
@@ -69,6 +78,10 @@ std::string validate(const PhysicsParams& p) {
     Vec3 s = p.tank.size();
     if (!is_finite(s) || s.x < 4.0f || s.y < 4.0f || s.z < 4.0f || s.x > 1.0e5f || s.z > 1.0e5f || s.y > 1.0e5f)
       err << "tank must be between 4 and 1e5 units on each side";
+    else if (p.stiffness < softest_stiffness(p))
+      err << "stiffness k = " << p.stiffness << " N/m is too soft for gravity " << p.gravity << " m/s^2 in a tank "
+          << s.y << " high: a pile that fills it would press balls through each other and the floor; k must be at "
+          << "least " << softest_stiffness(p) << " N/m (the default is " << PhysicsParams{}.stiffness << ")";
   }
   return err.str();
 }

@@ -69,6 +69,10 @@ int steps_for_tolerance(float tolerance);
 int steps_per_contact(const PhysicsParams& p);  // given, or from the tolerance
 float derived_dt(const PhysicsParams& p);
 inline float starting_skin(const PhysicsParams& p) { return p.skin > 0.0f ? p.skin : PhysicsParams::kStartSkin; }
+// The softest k the tank's gravity allows: a column of the heaviest balls as
+// tall as the tank presses its lowest contact in by less than the smallest
+// radius. Softer piles sink balls through each other and the floor.
+float softest_stiffness(const PhysicsParams& p);
 
 // Empty when the parameters are usable; otherwise a message that says which
 // value is wrong and what would be accepted.

@@ -1,6 +1,7 @@
 // A full tank, with the player sphere sweeping fast through the pile for 20
 // simulated seconds: no ball leaves the tank, none is lost, every value stays
-// finite, and the player stays inside.
+// finite, and the player stays inside. And the softest k the server accepts
+// (softest_stiffness) still holds a full tank's pile inside, which a third of it does not.
 
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -39,4 +40,22 @@ TEST_CASE("a full tank stays contained while the player ploughs through it", "[p
   CHECK(p.y >= params.tank.min.y);
   CHECK(p.y <= params.tank.max.y);
   CHECK(std::isfinite(kinetic_energy(world)));
+}
+
+TEST_CASE("at the softest k the server accepts a full tank's pile holds every ball inside, at a third of it not",
+          "[physics][containment][slow]") {
+  PhysicsParams params;
+  params.stiffness = softest_stiffness(params);
+  REQUIRE(validate(params).empty());
+  World world(params, kSseKernels, 2, 11);
+  pour_and_settle(world, 6000, 60.0);
+  INFO("deepest overlap " << max_overlap_fraction(world) << " of the smallest radius");
+  CHECK(escaped_or_invalid(world) == 0);
+  CHECK(max_overlap_fraction(world) < 1.0f);  // no contact pressed in past the smaller radius
+
+  // What the bound keeps out: a third as stiff, the pile presses balls through the floor.
+  params.stiffness /= 3.0f;
+  World soft(params, kSseKernels, 2, 11);
+  pour_and_settle(soft, 6000, 60.0);
+  CHECK(escaped_or_invalid(soft) > 0);
 }

@@ -42,6 +42,21 @@ TEST_CASE("unstable or absurd parameters are refused with a reason", "[params]")
     p.dt = contact_duration(p.stiffness) / 5.0f;
     CHECK(validate(p).find("unstable") != std::string::npos);
   }
+  SECTION("stiffness too soft for a pile under gravity, and the least allowed is accepted") {
+    // A column of 3 kg balls 40 high weighs 13.3 x 3 x 9.81 N: under 0.5 in, k >= 785 N/m.
+    CHECK(softest_stiffness(p) == Approx(40.0 / 3.0 * 3.0 * 9.81 / 0.5));
+    p.stiffness = 0.99f * softest_stiffness(p);
+    const std::string why = validate(p);
+    CHECK(why.find("too soft") != std::string::npos);
+    CHECK(why.find("at least 784.8 N/m") != std::string::npos);
+    p.stiffness = softest_stiffness(p);
+    CHECK(validate(p).empty());
+  }
+  SECTION("stiffness below 1 N/m, even without gravity") {
+    p.gravity = 0.0f;
+    p.stiffness = 0.5f;
+    CHECK(validate(p).find("stiffness k must be in [1, 1e9]") != std::string::npos);
+  }
   SECTION("stiffness NaN") {
     p.stiffness = std::numeric_limits<float>::quiet_NaN();
     CHECK(validate(p).find("stiffness") != std::string::npos);
