@@ -61,7 +61,11 @@ void pause_until(const std::atomic<std::uint64_t>& value, std::uint64_t seen, Cl
 }
 }  // namespace
 
-int WorkerPool::hardware_threads() { return std::max(1u, boost::thread::hardware_concurrency()); }
+int WorkerPool::hardware_threads() {
+  const std::size_t allowed = allowed_cpus().size();
+  return allowed > 0 ? static_cast<int>(allowed)
+                     : static_cast<int>(std::max(1u, boost::thread::hardware_concurrency()));
+}
 
 WorkerPool::WorkerPool(int threads, std::uint32_t granule)
     : thread_count_(std::clamp(threads, 1, 1 << 10)),

@@ -62,7 +62,8 @@ class WorkerPool {
   // For tests: called on a worker as it picks up a phase, to stall it on purpose. Set before the first run.
   void set_worker_hook(std::function<void(int thread)> hook) { worker_hook_ = std::move(hook); }
 
-  // The run-time default: one thread per available core.
+  // The run-time default: one thread per core this process may run on (its
+  // CPU affinity, as taskset or a container sets it), not per core installed.
   static int hardware_threads();
 
  private:

@@ -1,7 +1,8 @@
 // The worker pool hands every item to exactly one thread, in chunks that
 // start at multiples of its granule (of any length for costly items), and a
 // thread that is stalled or slow never holds up a run beyond the chunk it is
-// inside: the other threads take the chunks it has not started.
+// inside: the other threads take the chunks it has not started. Its default
+// size is the cores the process may run on.
 
 #include "server/physics/worker_pool.h"
 
@@ -202,4 +203,19 @@ TEST_CASE("while every thread steps, each is pinned to a CPU of its own, and bel
     CHECK(cpus_of_this_thread().size() == 1);
   }
   CHECK(cpus_of_this_thread() == allowed);  // the pool gave the caller its CPUs back
+}
+
+TEST_CASE("the default thread count is the cores this process may run on, as taskset restricts them", "[pool]") {
+  cpu_set_t all;
+  REQUIRE(sched_getaffinity(0, sizeof all, &all) == 0);
+  CHECK(WorkerPool::hardware_threads() == CPU_COUNT(&all));
+  int first = 0;
+  while (!CPU_ISSET(first, &all)) ++first;
+  cpu_set_t one;
+  CPU_ZERO(&one);
+  CPU_SET(first, &one);
+  REQUIRE(sched_setaffinity(0, sizeof one, &one) == 0);
+  const int restricted = WorkerPool::hardware_threads();
+  REQUIRE(sched_setaffinity(0, sizeof all, &all) == 0);
+  CHECK(restricted == 1);
 }
