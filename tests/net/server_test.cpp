@@ -8,6 +8,7 @@
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -78,6 +79,29 @@ std::vector<double> measure_rates(Clients& clients, const std::vector<std::share
   std::vector<double> rates;
   for (std::size_t i = 0; i < of.size(); ++i) rates.push_back((of[i]->stats().snapshots - before[i]) / seconds);
   return rates;
+}
+
+// Polls ready() until it holds (true) or timeout passes (false).
+bool wait_for(const std::function<bool()>& ready, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!ready()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return true;
+}
+
+// The server's status lines ("t = ... s  balls ..."), oldest first.
+std::vector<std::string> status_lines(const ServerProcess& server) {
+  std::vector<std::string> lines;
+  std::istringstream log(server.log());
+  for (std::string line; std::getline(log, line);)
+    if (line.rfind("t = ", 0) == 0) lines.push_back(line);
+  return lines;
+}
+
+bool codes_nothing(const std::string& status) {
+  return status.find("snapshot 0 us to encode, 0.00 frames") != std::string::npos;
 }
 
 }  // namespace
@@ -715,4 +739,24 @@ TEST_CASE("fishtank-client stops at --duration with connections still unopened, 
   CHECK(std::any_of(summary.error_messages.begin(), summary.error_messages.end(), [](const std::string& e) {
     return e.find("connections not opened: --duration ended") != std::string::npos;
   }));
+}
+
+TEST_CASE("no snapshot is captured or coded while nobody watches, and none once the last viewer has left", "[net]") {
+  ServerProcess server({"--balls", "300", "--status-interval", "0.25"});
+  REQUIRE(wait_for([&] { return status_lines(server).size() >= 4; }, std::chrono::seconds(10)));
+  for (const std::string& line : status_lines(server)) CHECK(codes_nothing(line));
+
+  Clients clients(server.port());
+  auto watcher = clients.add(false);
+  REQUIRE(clients.wait_until([&] { return watcher->stats().snapshots > 10; }, std::chrono::seconds(10)));
+  REQUIRE(wait_for([&] { return !codes_nothing(status_lines(server).back()); }, std::chrono::seconds(5)));
+
+  watcher->close();
+  REQUIRE(wait_for([&] { return server.log().find(") closed: ") != std::string::npos; }, std::chrono::seconds(5)));
+  const std::size_t after_leaving = status_lines(server).size();
+  // The window the viewer left in may have coded some; the two after it code none.
+  REQUIRE(wait_for([&] { return status_lines(server).size() >= after_leaving + 3; }, std::chrono::seconds(10)));
+  const std::vector<std::string> lines = status_lines(server);
+  CHECK(codes_nothing(lines[lines.size() - 1]));
+  CHECK(codes_nothing(lines[lines.size() - 2]));
 }
