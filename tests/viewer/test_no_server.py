@@ -31,6 +31,6 @@ def test_a_viewer_with_no_server_says_where_why_and_how_to_start_one_and_counts_
                         + re.escape(f"127.0.0.1:{port}"), run.stderr)
     assert summary, run.stderr
     # Counted from the end of the first frame (software rendering on a busy machine can make it slow) to the
-    # first past --duration.
+    # first past --duration; fps is printed to 0.1 and seconds to 0.01.
     frames, seconds, fps = int(summary.group(1)), float(summary.group(2)), float(summary.group(3))
-    assert frames >= 10 and 1.5 <= seconds <= 2.6 and fps == pytest.approx((frames - 1) / seconds, abs=0.06)
+    assert frames >= 10 and 1.5 <= seconds <= 2.6 and fps == pytest.approx((frames - 1) / seconds, abs=0.15)
