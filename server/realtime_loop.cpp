@@ -35,9 +35,12 @@ struct RateWindow {
     busy += batch_busy;
   }
   // Whether it has ended at `end`; then its rates are written into status and it starts again.
-  bool close(Clock::time_point end, double dt, LoopStatus& status) {
+  // It ends just after a step (stepped) while steps are due: a window that ended between steps
+  // far apart would count one step short and read as slow motion. If none comes within
+  // `wall_per_step` of its end, it ends anyway.
+  bool close(Clock::time_point end, bool stepped, double wall_per_step, double dt, LoopStatus& status) {
     const double span = seconds_between(start, end);
-    if (span < length) return false;
+    if (span < length || (!stepped && span < length + wall_per_step)) return false;
     status.steps_per_s = steps / span;
     status.load = busy / span;
     status.time_scale = steps * dt / span;
@@ -118,9 +121,10 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
     line.add(batch_steps, busy);
     status.threads = stepper.threads();
     status.crowding_cores = stepper.crowding_cores();
-    live.close(busy_end, dt, status);
+    const bool stepped = batch_steps > 0 || control.paused;  // paused, none are due
+    live.close(busy_end, stepped, wall_per_step, dt, status);
     LoopStatus line_status = status;
-    if (line.close(busy_end, dt, line_status)) {
+    if (line.close(busy_end, stepped, wall_per_step, dt, line_status)) {
       if (options.on_status) options.on_status(world, line_status);
       status.dropped_steps = 0;
     }

@@ -131,6 +131,9 @@ TEST_CASE("a step due later than the loop lets lag accrue still comes: soft cont
   INFO("dt " << world.dt() << " s, " << world.steps() << " steps");
   CHECK(seen.sim_seconds == Approx(0.15).margin(0.03));
   CHECK(seen.boundaries_per_s >= 30.0);
+  // Its status windows end just after a step: one that ended between two would count a step short.
+  REQUIRE(seen.time_scales.size() >= 3);
+  for (const double scale : seen.time_scales) CHECK_FALSE(slow_motion(scale, control.time_scale));
 }
 
 TEST_CASE("steps seconds apart leave the loop calling back at its rate and stopping on time", "[server][loop]") {
