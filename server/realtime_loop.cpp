@@ -24,8 +24,11 @@ double seconds_between(Clock::time_point from, Clock::time_point to) {
 }
 
 // Steps and busy time since `start`, turned into a status's rates once `length` has passed.
+// Its times are when steps fell due (the loop's sim_clock), not when they ran: a window
+// ended between steps far apart, or at a step woken late, would count a step short and
+// read as slow motion. Only time dropped while behind lowers the time scale.
 struct RateWindow {
-  Clock::time_point start;
+  double start;
   double length;
   std::uint64_t steps = 0;
   double busy = 0.0;
@@ -35,12 +38,9 @@ struct RateWindow {
     busy += batch_busy;
   }
   // Whether it has ended at `end`; then its rates are written into status and it starts again.
-  // It ends just after a step (stepped) while steps are due: a window that ended between steps
-  // far apart would count one step short and read as slow motion. If none comes within
-  // `wall_per_step` of its end, it ends anyway.
-  bool close(Clock::time_point end, bool stepped, double wall_per_step, double dt, LoopStatus& status) {
-    const double span = seconds_between(start, end);
-    if (span < length || (!stepped && span < length + wall_per_step)) return false;
+  bool close(double end, double dt, LoopStatus& status) {
+    const double span = end - start;
+    if (span < length) return false;
     status.steps_per_s = steps / span;
     status.load = busy / span;
     status.time_scale = steps * dt / span;
@@ -84,8 +84,8 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
   const Clock::time_point start = Clock::now();
   double sim_clock = 0.0;  // the wall time by which the steps done so far were due
   LoopStatus status;       // what at_step_boundary sees: rates of the latest live window
-  RateWindow live{start, std::min(options.status_interval, kLiveWindowSeconds)};
-  RateWindow line{start, options.status_interval};
+  RateWindow live{0.0, std::min(options.status_interval, kLiveWindowSeconds)};
+  RateWindow line{0.0, options.status_interval};
 
   while (!stop.load(std::memory_order_relaxed)) {
     const double now = seconds_between(start, Clock::now());
@@ -96,11 +96,12 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
     const double wall_per_step = dt / control.time_scale;
     if (control.paused) {
       sim_clock = now;
-    } else if (now - sim_clock > std::max(kMaxLagSeconds, wall_per_step)) {
-      // A step longer than the lag allowed (a soft k, a slowed clock) must still come due.
-      const double max_lag = std::max(kMaxLagSeconds, wall_per_step);
-      status.dropped_steps += static_cast<std::uint64_t>((now - sim_clock - max_lag) / wall_per_step);
-      sim_clock = now - max_lag;
+    } else if (now - sim_clock - wall_per_step > kMaxLagSeconds) {
+      // The lag is counted from when the next step fell due, so a step longer than the lag
+      // allowed (a soft k, a slowed clock) still comes, and a late wake-up is caught up on.
+      const double lag = now - sim_clock - wall_per_step;
+      status.dropped_steps += static_cast<std::uint64_t>((lag - kMaxLagSeconds) / wall_per_step);
+      sim_clock = now - wall_per_step - kMaxLagSeconds;
     }
     // Steps are due up to `now`, but the batch stops at its budget so that
     // snapshots, status and commands keep their rate whatever a step costs.
@@ -121,10 +122,9 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
     line.add(batch_steps, busy);
     status.threads = stepper.threads();
     status.crowding_cores = stepper.crowding_cores();
-    const bool stepped = batch_steps > 0 || control.paused;  // paused, none are due
-    live.close(busy_end, stepped, wall_per_step, dt, status);
+    live.close(sim_clock, dt, status);
     LoopStatus line_status = status;
-    if (line.close(busy_end, stepped, wall_per_step, dt, line_status)) {
+    if (line.close(sim_clock, dt, line_status)) {
       if (options.on_status) options.on_status(world, line_status);
       status.dropped_steps = 0;
     }
@@ -136,7 +136,7 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
     // the status line, stop).
     const double after = seconds_between(start, Clock::now());
     const double next_batch = sim_clock + std::max(wall_per_step, options.batch_seconds);
-    const double next_round = after + options.batch_seconds;
+    const double next_round = now + options.batch_seconds;
     const bool batch_due = !control.paused && next_batch <= next_round;
     const double wake_at = batch_due ? next_batch : next_round;
     const double wait = wake_at - after;
