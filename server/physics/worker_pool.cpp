@@ -34,14 +34,18 @@ std::uint64_t claims_word(std::uint32_t tag, std::uint32_t front, std::uint32_t 
   return std::uint64_t{tag} << 32 | std::uint64_t{front} << 16 | back;
 }
 
-// The CPUs this process may run on.
-std::vector<int> allowed_cpus() {
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  std::vector<int> cpus;
-  if (sched_getaffinity(0, sizeof set, &set) != 0) return cpus;
-  for (int c = 0; c < CPU_SETSIZE; ++c)
-    if (CPU_ISSET(c, &set)) cpus.push_back(c);
+// The CPUs this process may run on. Read once, on first use: the mask is the
+// calling thread's, and a pool pins its caller to one CPU while it steps.
+const std::vector<int>& allowed_cpus() {
+  static const std::vector<int> cpus = [] {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    std::vector<int> found;
+    if (sched_getaffinity(0, sizeof set, &set) != 0) return found;
+    for (int c = 0; c < CPU_SETSIZE; ++c)
+      if (CPU_ISSET(c, &set)) found.push_back(c);
+    return found;
+  }();
   return cpus;
 }
 

@@ -7,15 +7,19 @@ be written is refused before the run, not after it; fishtank-client pointed
 where nothing listens gives the command that starts a server there, and one
 whose connections are not all welcomed says so and fails; a server
 bound to every address gives the others an address that reaches it, not
-0.0.0.0."""
+0.0.0.0; a server given one core (taskset) starts one thread, not one per
+core installed."""
 
 import json
 import os
 import re
+import shutil
 import signal
 import socket
 import subprocess
 import time
+
+import pytest
 
 SERVER = os.path.join(os.environ["FISHTANK_BUILD_DIR"], "server", "fishtank-server")
 CLIENT = os.path.join(os.environ["FISHTANK_BUILD_DIR"], "client", "fishtank-client")
@@ -174,3 +178,12 @@ def test_a_server_that_takes_other_machines_gives_them_an_address_that_reaches_i
     local = subprocess.run([SERVER, "--port", "0", "--no-web", "--threads", "1", "--duration", "0.5"],
                            capture_output=True, text=True, timeout=30)
     assert "from other machines" not in local.stderr  # 127.0.0.1: no other machine gets in
+
+
+@pytest.mark.skipif(shutil.which("taskset") is None, reason="taskset (util-linux) is not installed")
+def test_a_server_given_one_core_starts_one_thread():
+    run = subprocess.run(["taskset", "-c", "0", SERVER, "--port", "0", "--no-web", "--balls", "0", "--duration",
+                          "0.3"], capture_output=True, text=True, timeout=30)
+    assert run.returncode == 0, run.stderr
+    assert re.search(r"fishtank-server \(sse, [^)]*, 1 thread\)", run.stderr), run.stderr
+    assert "oversubscribed" not in run.stderr
