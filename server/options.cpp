@@ -4,6 +4,7 @@
 #include <boost/asio/ip/address.hpp>
 #include <boost/program_options.hpp>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <vector>
 
@@ -118,10 +119,14 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "balls a minute each client may add, as many at once; beyond it rate_limited");
 
   po::options_description physics("Physics");
+  char stiffness_help[96];
+  std::snprintf(stiffness_help, sizeof stiffness_help,
+                "contact spring constant k, N/m, at least %.0f (softer piles sink through the floor)",
+                double(softest_stiffness(defaults)));
   physics.add_options()("stiffness", po::value(&o.physics.stiffness)->default_value(defaults.stiffness, "25000"),
-                        "contact spring constant k, N/m, at least 785 (softer piles sink through the floor)")(
-      "restitution", po::value(&o.physics.restitution)->default_value(defaults.restitution, "0.6"),
-      "coefficient of restitution e, (0, 1]")(
+                        stiffness_help)("restitution",
+                                        po::value(&o.physics.restitution)->default_value(defaults.restitution, "0.6"),
+                                        "coefficient of restitution e, (0, 1]")(
       "tolerance", po::value(&o.physics.tolerance)->default_value(defaults.tolerance, "0.005"),
       "largest per-collision restitution error allowed, [0.002, 0.0075]: sets the steps per contact")(
       "steps-per-contact", po::value(&steps_per_contact)->default_value(steps_per_contact),

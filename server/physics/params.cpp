@@ -8,7 +8,7 @@ namespace fishtank {
 
 namespace {
 constexpr float kPi = 3.14159265358979f;
-// Softer, even without gravity, a contact lasts over 2 s: steps too far apart to watch.
+// Softer, even without gravity, a contact lasts over 2.2 s: steps too far apart to watch.
 constexpr float kSoftestStiffness = 1.0f;
 }  // namespace
 
