@@ -24,9 +24,8 @@ TEST_CASE("every collision at the default settings is within 0.005 of the model'
   INFO(variant << " e = " << e << ": " << errors.within_5e3 << " of " << errors.collisions << " within 0.005, worst "
                << errors.worst << " (" << errors.worst_case << ")");
   CHECK(errors.collisions == 12 * 4 * 20);
-  CHECK(errors.within_5e3 >= 0.95 * errors.collisions);
-  CHECK(errors.worst <= 0.01f);
-  CHECK(errors.worst <= params.tolerance);  // what the status line states, in every variant the servers ship
+  // What the status line states, in every variant the servers ship (#41 asked 95 % within it, all within 0.01).
+  CHECK(errors.worst <= params.tolerance);
 }
 
 TEST_CASE("each tolerance meets itself: every collision at the steps it sets is within it",
