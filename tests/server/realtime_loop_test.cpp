@@ -131,7 +131,8 @@ TEST_CASE("a step due later than the loop lets lag accrue still comes: soft cont
   INFO("dt " << world.dt() << " s, " << world.steps() << " steps");
   CHECK(seen.sim_seconds == Approx(0.15).margin(0.03));
   CHECK(seen.boundaries_per_s >= 30.0);
-  // Its status windows end just after a step: one that ended between two would count a step short.
+  // Its windows are timed on when steps fell due: timed on the wall clock, a window ending between
+  // two steps or at one woken late would count a step short and read as slow motion.
   REQUIRE(seen.time_scales.size() >= 3);
   for (const double scale : seen.time_scales) CHECK_FALSE(slow_motion(scale, control.time_scale));
 }
