@@ -96,10 +96,9 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
     const double wall_per_step = dt / control.time_scale;
     if (control.paused) {
       sim_clock = now;
-    } else if (now - sim_clock - wall_per_step > kMaxLagSeconds) {
+    } else if (const double lag = now - sim_clock - wall_per_step; lag > kMaxLagSeconds) {
       // The lag is counted from when the next step fell due, so a step longer than the lag
       // allowed (a soft k, a slowed clock) still comes, and a late wake-up is caught up on.
-      const double lag = now - sim_clock - wall_per_step;
       status.dropped_steps += static_cast<std::uint64_t>((lag - kMaxLagSeconds) / wall_per_step);
       sim_clock = now - wall_per_step - kMaxLagSeconds;
     }
