@@ -59,6 +59,13 @@ PhysicsParams with_stiffness(float stiffness) {
   return params;
 }
 
+// run_paced with the clock set to `scale` of real time, as a viewer's [ and ] keys set it.
+Observed run_slowed(World& world, double seconds, double scale) {
+  RunControl control;
+  control.time_scale = scale;
+  return run_paced(world, seconds, &control);
+}
+
 // `balls` in a lattice, at rest.
 void place_lattice(World& world, int balls) {
   for (int b = 0; b < balls; ++b)
@@ -110,13 +117,12 @@ TEST_CASE("a time scale of one half advances half the simulated time, and is not
           "[server][loop]") {
   World world(with_stiffness(25000.0f), kSseKernels, 1, 5);
   place_lattice(world, 100);
-  RunControl control;
-  control.time_scale = 0.5;
-  const Observed seen = run_paced(world, 1.0, &control);
+  const double scale = 0.5;
+  const Observed seen = run_slowed(world, 1.0, scale);
   CHECK(seen.sim_seconds == Approx(0.5).margin(0.06));
   REQUIRE(seen.time_scales.size() >= 3);
   CHECK(seen.time_scales.back() == Approx(0.5).margin(0.06));
-  CHECK_FALSE(slow_motion(seen.time_scales.back(), control.time_scale));
+  CHECK_FALSE(slow_motion(seen.time_scales.back(), scale));
   CHECK(slow_motion(seen.time_scales.back()));  // against real time it is slower
 }
 
@@ -125,16 +131,15 @@ TEST_CASE("a step due later than the loop lets lag accrue still comes: soft cont
   // k = 1000 N/m: dt = 5.4 ms, 54 ms of wall time a step at x0.1, more than the 50 ms of lag caught up on.
   World world(with_stiffness(1000.0f), kSseKernels, 1, 5);
   place_lattice(world, 100);
-  RunControl control;
-  control.time_scale = 0.1;
-  const Observed seen = run_paced(world, 1.5, &control);
+  const double scale = 0.1;
+  const Observed seen = run_slowed(world, 1.5, scale);
   INFO("dt " << world.dt() << " s, " << world.steps() << " steps");
   CHECK(seen.sim_seconds == Approx(0.15).margin(0.03));
   CHECK(seen.boundaries_per_s >= 30.0);
   // Its windows are timed on when steps fell due: timed on the wall clock, a window ending between
   // two steps or at one woken late would count a step short and read as slow motion.
   REQUIRE(seen.time_scales.size() >= 3);
-  for (const double scale : seen.time_scales) CHECK_FALSE(slow_motion(scale, control.time_scale));
+  for (const double time_scale : seen.time_scales) CHECK_FALSE(slow_motion(time_scale, scale));
 }
 
 TEST_CASE("steps seconds apart leave the loop calling back at its rate and stopping on time", "[server][loop]") {
@@ -144,9 +149,7 @@ TEST_CASE("steps seconds apart leave the loop calling back at its rate and stopp
   REQUIRE(validate(params).empty());
   World world(params, kSseKernels, 1, 5);
   place_lattice(world, 100);
-  RunControl control;
-  control.time_scale = 0.1;
-  const Observed seen = run_paced(world, 0.5, &control);
+  const Observed seen = run_slowed(world, 0.5, 0.1);
   INFO("dt " << world.dt() << " s");
   CHECK(seen.boundaries_per_s >= 30.0);  // commands, snapshots and stop are not kept waiting for the step
   CHECK(seen.wall_seconds < 1.0);
