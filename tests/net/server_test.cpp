@@ -100,7 +100,7 @@ std::vector<std::string> status_lines(const ServerProcess& server) {
   return lines;
 }
 
-// Neither captured (0 us) nor coded (no frame, no byte, no keyframe).
+// The status line of a window in which no snapshot was captured and no frame coded.
 bool codes_nothing(const std::string& status) {
   return status.find("snapshot 0 us to encode, 0.00 frames of 0 B mean, 0 keyframes") != std::string::npos;
 }
