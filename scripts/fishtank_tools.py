@@ -475,6 +475,20 @@ def machine_line(m):
     return f"{m['cpu']}, {m['cores']} cores, AVX2 {'yes' if m['avx2'] else 'no'}; {m['date']}; commit {m['commit']}"
 
 
+def record_conditions(part, m, detail=""):
+    """One line per figure in docs/figures/perf-conditions.txt, replacing that figure's last: when, at which
+    commit and on what machine m (machine(), taken as the measurement started) it was measured."""
+    path = os.path.join(FIGURES, "perf-conditions.txt")
+    kept = []
+    if os.path.exists(path):
+        with open(path) as f:
+            kept = [line for line in f.read().splitlines() if not line.startswith(part + ":")]
+    kept.append(f"{part}: {m['date']}, commit {m['commit']}, {detail + ', ' if detail else ''}"
+                f"{m['cpu']}, {m['cores']} cores, avx2 {'yes' if m['avx2'] else 'no'}")
+    with open(path, "w") as f:
+        f.write("\n".join(sorted(kept)) + "\n")
+
+
 # ------------------------------------------------------------------ as a program
 
 def main(argv):
@@ -488,6 +502,9 @@ def main(argv):
                         help="seconds to wait (default 30; 0: as long as --pid lives)")
     sub.add_parser("variants", help="the variants compared on this machine, with their flags")
     sub.add_parser("machine", help="CPU, cores, date and commit")
+    conditions = sub.add_parser("conditions", help="record this machine, date and commit for a figure in "
+                                "docs/figures/perf-conditions.txt (for the scripts not in Python)")
+    conditions.add_argument("figure", help="the figure's name, e.g. abuse")
     args = parser.parse_args(argv)
     if args.command == "listening":
         if args.timeout < 0 or (args.timeout == 0 and args.pid is None):
@@ -521,6 +538,8 @@ def main(argv):
     elif args.command == "variants":
         for v in variants():
             print(f"{v.label}: {v.program} {' '.join(v.flags)}")
+    elif args.command == "conditions":
+        record_conditions(args.figure, machine())
     else:
         print(machine_line(machine()))
     return 0
