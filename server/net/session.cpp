@@ -47,9 +47,13 @@ void Session::read_on() {
 void Session::carry_out(Outcome outcome) {
   if (closed_) return;
   if (!outcome.log.empty()) spdlog::info("client {}: {}", id_, outcome.log);
+  // One that is ending has queued its last word, an Error: nothing is sent after it.
+  if (close_after_write_) return;
+  // Join and Leave are always queued, so what is dropped here is a command whose other
+  // replies (a partial add's refusal) no longer hold: the refusal replaces them.
   if (outcome.command && !owner_.submit(std::move(*outcome.command))) return carry_out(protocol_.on_queue_full());
   for (protocol::Frame& reply : outcome.replies) replies_.push_back(std::move(reply));
-  if (outcome.disconnect && !close_after_write_) {
+  if (outcome.disconnect) {
     close_after_write_ = true;
     hard_close_at_ = Clock::now() + kErrorGrace;
     arm_watchdog();
@@ -67,7 +71,8 @@ void Session::offer_snapshot(SharedSnapshot snapshot) {
 }
 
 void Session::deliver(const Reply& reply) {
-  if (closed_) return;
+  // A Welcome or sphere that reaches a session already ending is neither sent nor counted.
+  if (closed_ || close_after_write_) return;
   const bool was_welcomed = protocol_.welcomed(), had_player = protocol_.has_player();
   Outcome outcome = protocol_.on_reply(reply);
   // Counted before carry_out, which may close the session (and so uncount it).

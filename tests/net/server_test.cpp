@@ -21,6 +21,7 @@
 
 using namespace fishtank;
 using client::Connection;
+using test::error_codes;
 using test::first_error_code;
 using test::frame_with_length;
 using test::RawSocket;
@@ -489,6 +490,21 @@ TEST_CASE("bad bytes from one client: Error and disconnect for it - the server a
     std::vector<std::uint8_t> got;
     CHECK(raw.read_until_closed(got, std::chrono::seconds(5)));
     CHECK(first_error_code(got) == "expected_hello");
+  }
+  SECTION("a Hello and garbage in one write: the Error is the last word, and the log says why the connection ended") {
+    RawSocket raw(server.port());
+    protocol::Frame bytes = protocol::encode_hello("hello-then-garbage", true, false);
+    const protocol::Frame garbage = frame_with_length(64, 64);
+    bytes.insert(bytes.end(), garbage.begin(), garbage.end());
+    raw.send(bytes);
+    std::vector<std::uint8_t> got;
+    CHECK(raw.read_until_closed(got, std::chrono::seconds(5)));
+    CHECK(error_codes(got) == std::vector<std::string>{"malformed_frame"});
+    // The socket kept open, the server waits out its grace: the physics thread's Welcome for the
+    // Hello comes meanwhile, and is not written after the farewell (a write there failed: "Broken pipe").
+    REQUIRE(wait_for([&] { return server.log().find("('hello-then-garbage') closed: ") != std::string::npos; },
+                     std::chrono::seconds(5)));
+    CHECK_THAT(server.log(), Catch::Contains("('hello-then-garbage') closed: disconnected by the server"));
   }
   SECTION("half a frame, then the client disconnects") {
     RawSocket raw(server.port());
