@@ -291,6 +291,7 @@ Outcome ClientProtocol::on_reply(const Reply& reply) {
     using Why = ControlRefusedReply::Why;
     const wire::ErrorCode code = control->why == Why::not_paused    ? wire::ErrorCode::not_paused
                                  : control->why == Why::fewer_balls ? wire::ErrorCode::tank_full
+                                 : control->why == Why::superseded  ? wire::ErrorCode::superseded
                                                                     : wire::ErrorCode::server_busy;
     return refuse(code, control->refusal, /*disconnect=*/false);
   }

@@ -74,7 +74,8 @@ struct ControlRefusedReply {
   enum class Why {
     not_paused,   // a Step while running: nothing done
     fewer_balls,  // the scene started with fewer balls than asked
-    too_soon      // a Reset before the last one's spacing was up: nothing done
+    too_soon,     // a Reset before the last one's spacing was up: nothing done
+    superseded    // a Reset replaced by another client's later one at the same step boundary: nothing done
   };
   Why why = Why::not_paused;
   std::string refusal;

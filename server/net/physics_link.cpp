@@ -36,8 +36,18 @@ void PhysicsLink::at_step_boundary(World& world, const LoopStatus& status) {
   std::size_t last_reset = drained_.size();
   for (std::size_t i = 0; i < drained_.size(); ++i)
     if (std::holds_alternative<ResetCommand>(drained_[i].action)) last_reset = i;
-  for (std::size_t i = 0; i < drained_.size(); ++i)
-    if (i == last_reset || !std::holds_alternative<ResetCommand>(drained_[i].action)) apply(world, drained_[i]);
+  for (std::size_t i = 0; i < drained_.size(); ++i) {
+    const Command& command = drained_[i];
+    if (i == last_reset || !std::holds_alternative<ResetCommand>(command.action)) {
+      apply(world, command);
+    } else if (command.client_id != drained_[last_reset].client_id) {
+      // Another client's switch must not pass for this one's (its own later Reset speaks for it).
+      reply_({command.client_id,
+              ControlRefusedReply{ControlRefusedReply::Why::superseded,
+                                  "Reset not carried out: another client's Reset reached the server at the same "
+                                  "moment and replaced it; send it again to have it"}});
+    }
+  }
 
   const Clock::time_point now = Clock::now();
   if (now < next_snapshot_) return;

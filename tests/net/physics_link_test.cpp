@@ -1,0 +1,75 @@
+// The physics thread's side of the network (PhysicsLink), driven directly: the
+// commands queued between two step boundaries, and the answers it hands back.
+
+#include "server/net/physics_link.h"
+
+#include <catch2/catch.hpp>
+#include <string>
+#include <vector>
+
+using namespace fishtank;
+using namespace fishtank::net;
+
+namespace {
+
+struct Link {
+  CommandQueue queue;
+  std::atomic<int> viewers{0};
+  RunControl control;
+  ActiveScene scene{SceneChoice{"tank", 1, 200, 0}};
+  std::vector<Reply> replies;
+  World world;
+  PhysicsLink link;
+
+  Link()
+      : world(params(), kSseKernels, 1, 1),
+        link(
+            queue, viewers, PhysicsLinkOptions{}, control, scene, [this](Reply r) { replies.push_back(std::move(r)); },
+            [](SharedSnapshot) {}) {
+    REQUIRE(scene.start(world).empty());
+  }
+  PhysicsParams params() const {
+    PhysicsParams p;
+    p.tank = scene.first_tank();
+    return p;
+  }
+  void reset(std::uint32_t client, const std::string& scene_name) {
+    REQUIRE(queue.push(Command{client, ResetCommand{scene_name, std::nullopt}}));
+  }
+  // The refusals of client's controls, in order.
+  std::vector<ControlRefusedReply::Why> refusals_of(std::uint32_t client) const {
+    std::vector<ControlRefusedReply::Why> out;
+    for (const Reply& r : replies)
+      if (const auto* refused = std::get_if<ControlRefusedReply>(&r.result); refused && r.client_id == client)
+        out.push_back(refused->why);
+    return out;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("of resets queued at one step boundary only the last is carried out; another client's earlier one is told",
+          "[net][sandbox]") {
+  Link l;
+  const std::uint32_t starts = l.scene.start_count();
+  l.reset(1, "drop");
+  l.reset(1, "wide");
+  l.reset(2, "dam-break");
+  l.link.at_step_boundary(l.world, LoopStatus{});
+
+  CHECK(l.scene.start_count() == starts + 1);
+  CHECK(l.scene.name() == "dam-break");
+  // Client 1's switches did not happen and it hears so, once for each; client 2's did, without a word.
+  CHECK(l.refusals_of(1) == std::vector<ControlRefusedReply::Why>{ControlRefusedReply::Why::superseded,
+                                                                  ControlRefusedReply::Why::superseded});
+  CHECK(l.refusals_of(2).empty());
+}
+
+TEST_CASE("a client's own later reset replaces its earlier one without a refusal", "[net][sandbox]") {
+  Link l;
+  l.reset(3, "drop");
+  l.reset(3, "wide");
+  l.link.at_step_boundary(l.world, LoopStatus{});
+  CHECK(l.scene.name() == "wide");
+  CHECK(l.replies.empty());
+}
