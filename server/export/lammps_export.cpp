@@ -6,6 +6,9 @@
 #include <filesystem>
 #include <vector>
 
+#include "server/export/finish_file.h"
+#include "server/physics/world_measures.h"
+
 namespace fishtank {
 
 namespace {
@@ -15,12 +18,6 @@ constexpr double kPi = 3.14159265358979323846;
 // Balls squeezed into a wall reach past its face; LAMMPS loses atoms that
 // leave a fixed box, so the box extends one largest diameter past the tank.
 constexpr float kBoxMargin = kMaxBallDiameter;
-
-std::vector<std::uint32_t> indices_by_id(const World& world) {
-  std::vector<std::uint32_t> by_id(world.ball_count());
-  for (std::uint32_t i = 0; i < world.ball_count(); ++i) by_id[world.ids()[i]] = i;
-  return by_id;
-}
 
 void write_box(std::FILE* f, const TankBounds& t, const char* format) {
   std::fprintf(f, format, t.min.x - kBoxMargin, t.max.x + kBoxMargin, t.min.y - kBoxMargin, t.max.y + kBoxMargin,
@@ -47,9 +44,7 @@ std::string write_data(const World& world, const std::string& path) {
     const Float4& v = world.velocities()[by_id[id]];
     std::fprintf(f, "%u %.9g %.9g %.9g 0 0 0\n", id + 1, v.x, v.y, v.z);
   }
-  bool ok = std::fflush(f) == 0;
-  ok = std::fclose(f) == 0 && ok;
-  return ok ? "" : "error while writing " + path;
+  return finish_file(f, path);
 }
 
 std::string write_input(const World& world, const std::string& path, std::uint64_t run_steps) {
@@ -89,9 +84,7 @@ std::string write_input(const World& world, const std::string& path, std::uint64
                "\ntimestep %.9g\ncompute ke all ke\nthermo_style custom step time atoms c_ke\nthermo 1000\n"
                "run %llu\n",
                world.dt(), static_cast<unsigned long long>(run_steps));
-  bool ok = std::fflush(f) == 0;
-  ok = std::fclose(f) == 0 && ok;
-  return ok ? "" : "error while writing " + path;
+  return finish_file(f, path);
 }
 
 }  // namespace
@@ -114,10 +107,9 @@ LammpsDumpWriter::~LammpsDumpWriter() { close(); }  // an owner that cares asked
 
 std::string LammpsDumpWriter::close() {
   if (!file_) return "";
-  bool ok = std::fflush(file_) == 0 && !std::ferror(file_);
-  ok = std::fclose(file_) == 0 && ok;
+  std::FILE* f = file_;
   file_ = nullptr;
-  return ok ? "" : "error while writing " + path_;
+  return finish_file(f, path_);
 }
 
 std::string LammpsDumpWriter::open(const std::string& path) {

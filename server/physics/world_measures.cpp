@@ -134,18 +134,20 @@ std::uint32_t escaped_or_invalid(const World& world) {
   return bad;
 }
 
+std::vector<std::uint32_t> indices_by_id(const World& world) {
+  std::vector<std::uint32_t> by_id(world.ball_count());
+  for (std::uint32_t i = 0; i < world.ball_count(); ++i) by_id[world.ids()[i]] = i;
+  return by_id;
+}
+
 std::uint64_t state_hash(const World& world) {
-  const std::uint32_t n = world.ball_count();
   const Float4 *pos = world.positions(), *vel = world.velocities();
-  const std::uint32_t* ids = world.ids();
-  std::vector<std::uint32_t> by_id(n);
-  for (std::uint32_t i = 0; i < n; ++i) by_id[ids[i]] = i;
   std::uint64_t h = 1469598103934665603ull;
   auto mix = [&h](const void* data, std::size_t bytes) {
     const auto* b = static_cast<const unsigned char*>(data);
     for (std::size_t k = 0; k < bytes; ++k) h = (h ^ b[k]) * 1099511628211ull;
   };
-  for (std::uint32_t i : by_id) {
+  for (std::uint32_t i : indices_by_id(world)) {
     mix(&pos[i], sizeof(Float4));
     mix(&vel[i], sizeof(Float4));
   }

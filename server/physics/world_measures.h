@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "common/float4.h"
 #include "server/physics/world.h"
@@ -34,6 +35,8 @@ float pile_top(const World& world);  // highest point of any ball
 std::uint32_t escaped_or_invalid(const World& world);
 // FNV-1a over positions and velocities in id order: equal iff bit-identical.
 std::uint64_t state_hash(const World& world);
+// Where each ball id sits in the world's arrays (which the step keeps sorted by cell): entry id is its index.
+std::vector<std::uint32_t> indices_by_id(const World& world);
 // The mean length of the last build's lists.
 double mean_neighbours(const World& world);
 
