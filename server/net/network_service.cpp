@@ -36,8 +36,18 @@ NetworkService::NetworkService(const NetOptions& options, ServerInfo info, RunCo
           commands_, server_.viewers(), options.link, control, scene,
           [this](Reply reply) { server_.post_reply(std::move(reply)); },
           [this](SharedSnapshot snapshot) { server_.post_snapshot(std::move(snapshot)); }) {
-  signals_.async_wait([&stop](boost::system::error_code ec, int) {
-    if (!ec) stop = true;
+  signals_.async_wait([this, &stop](boost::system::error_code ec, int) {
+    if (ec) return;
+    stop = true;
+    // The set keeps the signals until the server ends, so a second one must be heard here: while
+    // the final files are written (a blocked or huge --dump), it ends the process at once.
+    signals_.async_wait([](boost::system::error_code again, int signal) {
+      if (again) return;
+      std::fprintf(stderr,
+                   "fishtank-server: %s again: stopping at once; output files not finished are left as they are\n",
+                   signal == SIGINT ? "interrupted" : "terminated");
+      std::_Exit(128 + signal);
+    });
   });
 }
 

@@ -8,7 +8,7 @@ where nothing listens gives the command that starts a server there, and one
 whose connections are not all welcomed says so and fails; a server
 bound to every address gives the others an address that reaches it, not
 0.0.0.0; a server given one core (taskset) starts one thread, not one per
-core installed."""
+core installed; a second Ctrl-C ends a server that is writing its final files."""
 
 import json
 import os
@@ -187,3 +187,25 @@ def test_a_server_given_one_core_starts_one_thread():
     assert run.returncode == 0, run.stderr
     assert re.search(r"fishtank-server \(sse, [^)]*, 1 thread\)", run.stderr), run.stderr
     assert "oversubscribed" not in run.stderr
+
+
+def test_a_second_ctrl_c_ends_a_server_that_is_writing_its_final_files(tmp_path):
+    # A million balls' final files take the server a second or more to write: long enough to interrupt.
+    server = subprocess.Popen([SERVER, "--port", "0", "--no-web", "--scene", "wide", "--balls", "1000000",
+                               "--dump", str(tmp_path / "final.csv"), "--export-lammps", str(tmp_path / "lammps")],
+                              stderr=subprocess.PIPE, text=True)
+    try:
+        line = server.stderr.readline()
+        while "Ctrl-C stops" not in line:
+            assert line, "the server ended before its banner"
+            line = server.stderr.readline()
+        server.send_signal(signal.SIGINT)
+        while "stopped after" not in line:  # it stops stepping and goes on to the files
+            line = server.stderr.readline()
+            assert line, "the server ended without saying it stopped"
+        server.send_signal(signal.SIGINT)
+        assert server.wait(timeout=10) == 128 + signal.SIGINT, "the files were finished: the second Ctrl-C waited"
+        assert "interrupted again: stopping at once" in server.stderr.read()
+    finally:
+        server.kill()
+        server.wait()
