@@ -320,6 +320,22 @@ class Client:
         return self._wait_for(lambda s: s.scene_start != before)
 
     def _send(self, frame):
+        """Sends for the caller: a connection that has ended raises why it ended (the server's last Error), not
+        a bare broken pipe, and not only from the second send after it."""
+        with self._changed:
+            if self._ended is not None:
+                raise self._ended
+        try:
+            self._send_frame(frame)
+        except TimeoutError:
+            raise self._timed_out() from None
+        except OSError as e:
+            with self._changed:  # the reader is about to learn why (the server's farewell, or the reset)
+                if self._changed.wait_for(lambda: self._ended is not None, timeout=1.0):
+                    raise self._ended from None
+            raise ConnectionError(f"the connection to {self.address} failed: {e.strerror or e}") from None
+
+    def _send_frame(self, frame):
         with self._send_lock:
             self._sock.sendall(frame)
 
@@ -418,7 +434,8 @@ class Client:
     def _acknowledge(self, tick):
         """Ack with want_keyframe: this client holds no base to decode a delta against, so the next comes in full."""
         try:
-            self._send(_frame(Payload.Payload.Ack, lambda b: self._table(b, Ack, AddTick=tick, AddWantKeyframe=True)))
+            self._send_frame(_frame(Payload.Payload.Ack,
+                                    lambda b: self._table(b, Ack, AddTick=tick, AddWantKeyframe=True)))
         except OSError:
             pass  # the server closed the connection: the frames before that say why, and then recv() ends
 

@@ -331,6 +331,21 @@ def test_add_balls_beyond_the_rate_limit_says_rate_limited_before_the_tank_is_fu
     assert limited.value.code == "rate_limited" and "added at most 3000 of 100000" in limited.value.message
 
 
+def test_a_connection_the_server_ended_raises_its_reason_at_the_next_call_not_a_broken_pipe(start_server):
+    server = start_server("--balls", "50", "--max-commands", "20")
+    with Client("127.0.0.1", server.port) as tank:
+        with pytest.raises(FishtankError) as flood:
+            for _ in range(10000):  # far past 20 messages a second: the server closes it with command_flood
+                tank.move((1, 0, 0))
+        assert flood.value.code == "command_flood"
+        time.sleep(2.5)  # the server's grace for its last word is over: the socket is gone, sends fail
+        for _ in range(3):  # every later call, a send or a wait, says why the connection ended
+            with pytest.raises(ConnectionError, match="closed the connection \\(command_flood: "):
+                tank.move((1, 0, 0))
+        with pytest.raises(ConnectionError, match="command_flood"):
+            tank.snapshot()
+
+
 def test_a_program_that_reads_less_often_than_the_servers_idle_timeout_keeps_its_connection(start_server):
     """Snapshots the program has not asked for yet do not pile up in the sockets until the server gives up on
     the connection (a write stalled for --idle-timeout): the client reads them as they come."""
