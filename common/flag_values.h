@@ -9,15 +9,23 @@
 
 namespace fishtank {
 
-// Parses argv against flags like po::parse_command_line; throws po::error naming the flag whose value is a flag.
+// Parses argv against flags like po::parse_command_line; throws po::error naming the flag whose value is a flag,
+// or a word that belongs to no flag (Boost drops those: "fishtank-client 10.0.0.5:7878" connected to the default).
 inline boost::program_options::parsed_options parse_flags(int argc, const char* const argv[],
                                                           const boost::program_options::options_description& flags) {
   namespace po = boost::program_options;
   po::parsed_options parsed = po::parse_command_line(argc, argv, flags);
-  for (const po::option& option : parsed.options)
+  for (const po::option& option : parsed.options) {
+    if (option.position_key >= 0) {
+      const std::string& word = option.value.front();
+      const bool address = word.find(':') != std::string::npos && flags.find_nothrow("connect", false);
+      throw po::error("unexpected '" + word + "': every setting is a flag and its value" +
+                      (address ? " (did you mean --connect " + word + "?)" : ""));
+    }
     for (const std::string& value : option.value)
       if (value.rfind("--", 0) == 0)
         throw po::error("--" + option.string_key + " wants a value, got the flag '" + value + "'");
+  }
   return parsed;
 }
 

@@ -1,7 +1,9 @@
 """A flag given without its value does not take the next flag as the value: each program refuses "--record
 --bench", "--out --quick" and the like with exit code 2, naming both, and writes nothing (the server would
 have recorded into a file named "--bench" and run the daemon). A value with one dash is still a value ("--move
--2,0,0"). fishtank-client refuses a value out of range with the range and the value given."""
+-2,0,0"). A word that belongs to no flag is refused the same way, not dropped (fishtank-client 10.0.0.5:7878
+connected to the default address). fishtank-client refuses a value out of range with the range and the value
+given."""
 
 import os
 import subprocess
@@ -26,6 +28,26 @@ def test_a_flag_missing_its_value_is_refused_and_nothing_is_written(tmp_path, pr
     run = subprocess.run([path, *flags], capture_output=True, text=True, timeout=60, cwd=tmp_path)
     assert run.returncode == 2, run.stderr
     assert run.stderr.splitlines() == [f"{os.path.basename(program)}: {named}", "Try --help for the list of options."]
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("program, words, said", [
+    ("server/fishtank-server", ["3000", "--duration", "0.1"],
+     "unexpected '3000': every setting is a flag and its value"),
+    ("server/fishtank-accuracy", ["--quick", "collisions"],
+     "unexpected 'collisions': every setting is a flag and its value"),
+    ("client/fishtank-client", ["127.0.0.1:1", "--duration", "0.1"],
+     "unexpected '127.0.0.1:1': every setting is a flag and its value (did you mean --connect 127.0.0.1:1?)"),
+    ("viewer/fishtank-viewer", ["127.0.0.1:1", "--duration", "0.1"],
+     "unexpected '127.0.0.1:1': every setting is a flag and its value (did you mean --connect 127.0.0.1:1?)"),
+])
+def test_a_word_that_belongs_to_no_flag_is_refused_not_dropped(tmp_path, program, words, said):
+    path = os.path.join(BUILD, program)
+    if not os.path.exists(path):
+        pytest.skip(f"{program} is not built here")
+    run = subprocess.run([path, *words], capture_output=True, text=True, timeout=60, cwd=tmp_path)
+    assert run.returncode == 2, run.stderr
+    assert run.stderr.splitlines() == [f"{os.path.basename(program)}: {said}", "Try --help for the list of options."]
     assert list(tmp_path.iterdir()) == []
 
 
