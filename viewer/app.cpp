@@ -173,6 +173,7 @@ int run_viewer(const ViewerOptions& opt) {
   if (opt.fullscreen) fullscreen.toggle();
 
   int exit_code = 0;
+  bool screenshot_tried = false;  // --screenshot saved, failed or timed out: each says so
   {
     // Scope: every GL object is destroyed while the context still exists.
     Input input(window);
@@ -305,11 +306,13 @@ int run_viewer(const ViewerOptions& opt) {
       if (!opt.screenshot.empty()) {
         if (have_frame && ++frames_since_snapshot >= opt.frames) {
           if (!save_screenshot(opt.screenshot, width, height)) exit_code = 1;
+          screenshot_tried = true;
           glfwSetWindowShouldClose(window, GLFW_TRUE);
         } else if (!have_frame && frame_start - started > opt.screenshot_timeout) {
           std::fprintf(stderr, "fishtank-viewer: no snapshot from %s within %.0f s: %s\n",
                        status.endpoint.c_str(), opt.screenshot_timeout, status.last_error.c_str());
           exit_code = 1;
+          screenshot_tried = true;
           glfwSetWindowShouldClose(window, GLFW_TRUE);
         }
       }
@@ -321,6 +324,13 @@ int run_viewer(const ViewerOptions& opt) {
 
     const std::shared_ptr<const Snapshot> last = snapshots.newest();
     print_summary(stats, net.status(), last ? last->ball_count : 0u);
+    // Closed first (--duration, the window): a script waiting for the file must not read success.
+    if (!opt.screenshot.empty() && !screenshot_tried) {
+      std::fprintf(stderr, "fishtank-viewer: --screenshot %s not saved: the viewer closed before %s\n",
+                   opt.screenshot.c_str(),
+                   stats.total_frames() > 0 ? "its --frames were drawn" : "the first snapshot came");
+      exit_code = 1;
+    }
   }
   glfwDestroyWindow(window);
   return exit_code;

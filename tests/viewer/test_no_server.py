@@ -1,7 +1,8 @@
 """A viewer pointed at a port where nothing listens says so on the terminal:
 the address, why (connection refused) and the exact command that starts a
 server on that port, once, not at every retry; at exit it counts the frames it
-really drew, none of them with the scene. Under Xvfb; skipped without xvfb-run."""
+really drew, none of them with the scene. A --screenshot it could not take
+fails the run and says why. Under Xvfb; skipped without xvfb-run."""
 
 import os
 import re
@@ -34,3 +35,17 @@ def test_a_viewer_with_no_server_says_where_why_and_how_to_start_one_and_counts_
     # first past --duration; fps is printed to 0.1 and seconds to 0.01.
     frames, seconds, fps = int(summary.group(1)), float(summary.group(2)), float(summary.group(3))
     assert frames >= 10 and 1.5 <= seconds <= 2.6 and fps == pytest.approx((frames - 1) / seconds, abs=0.15)
+
+
+@pytest.mark.skipif(shutil.which("xvfb-run") is None, reason="xvfb-run is not installed (scripts/install-deps viewer)")
+def test_a_screenshot_the_viewer_closed_before_taking_fails_the_run_and_says_why(tmp_path):
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    shot = tmp_path / "shot.png"
+    run = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", VIEWER, "--connect",
+                          f"127.0.0.1:{port}", "--duration", "1", "--screenshot", str(shot)],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 1, run.stderr
+    assert f"--screenshot {shot} not saved: the viewer closed before the first snapshot came" in run.stderr
+    assert not shot.exists()
