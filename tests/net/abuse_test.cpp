@@ -19,6 +19,7 @@
 
 #include "background_client.h"
 #include "protocol/frame_codec.h"
+#include "raw_socket.h"
 #include "server_process.h"
 #include "wire_bytes.h"
 
@@ -78,18 +79,6 @@ std::vector<std::unique_ptr<RawSocket>> stalled_peers(std::uint16_t port, int pe
   return sockets;
 }
 
-// Waits (at most `timeout`) until the server's log has `text`; the seconds it took.
-double wait_for_log(
-    ServerProcess& server, const std::string& text, std::chrono::seconds timeout,
-    const std::function<void()>& meanwhile = [] {}) {
-  const Clock::time_point start = Clock::now();
-  while (server.log().find(text) == std::string::npos && Clock::now() - start < timeout) {
-    meanwhile();
-    std::this_thread::sleep_for(50ms);
-  }
-  return seconds_since(start);
-}
-
 long rss_growth_kb(ServerProcess& server, long before_kb) { return server.rss_kb() - before_kb; }
 
 void check_rss_growth(long growth_kb, long limit_kb) {
@@ -115,9 +104,15 @@ void check_non_reader(bool sends, const std::string& code, const std::string& at
   std::uint32_t sequence = 0;
   double seconds = 0.0;
   const double rate = snapshot_rate(*honest, [&] {
-    seconds = wait_for_log(server, code, 15s, [&] {
-      if (sends) peer.send(protocol::encode_player_input(++sequence, {0.0f, 0.0f, 0.0f}));
-    });
+    const Clock::time_point start = Clock::now();
+    wait_until(
+        [&] {
+          if (server.log().find(code) != std::string::npos) return true;
+          if (sends) peer.send(protocol::encode_player_input(++sequence, {0.0f, 0.0f, 0.0f}));
+          return false;
+        },
+        15s);
+    seconds = seconds_since(start);
   });
   std::vector<std::uint8_t> got;
   const bool closed = peer.read_until_closed(got, 5s);
@@ -164,7 +159,7 @@ TEST_CASE("abuse: 500 peers say Hello, announce 1 MiB, send one byte and stall -
     std::this_thread::sleep_for(1500ms);
   });
   // All held, none refused; the server may still be accepting the last of them from its backlog.
-  wait_for_log(server, "client 501 connected", 10s);
+  server.wait_for_log("client 501 connected", 10s);
   CHECK_THAT(server.log(), Catch::Contains("client 501 connected"));
   const long growth = rss_growth_kb(server, rss_before);
   record("500 peers say Hello, announce a 1 MiB frame, send 1 byte of it and stall",
@@ -194,7 +189,7 @@ TEST_CASE("abuse: when every place belongs to a client past Hello, newcomers get
   int stayed = 0;
   for (auto& watcher : watchers) stayed += !watcher->state().closed && watcher->state().snapshots > 30;
   watchers.pop_back();
-  wait_for_log(server, "('watcher') closed", 5s);  // its place is free only once the server saw it leave
+  server.wait_for_log("('watcher') closed", 5s);  // its place is free only once the server saw it leave
   BackgroundClient newcomer(server.port(), false, "newcomer");
   const bool admitted = newcomer.wait_until([](const ClientState& s) { return s.welcomed; }, 5s);
   record("6 observers past Hello fill --max-connections 6, 30 more arrive", "sessions past Hello are never evicted",
@@ -217,7 +212,8 @@ TEST_CASE("abuse: a newcomer to a table full of connections without Hello evicts
   bool welcomed = false, oldest_closed = false;
   const double rate = snapshot_rate(*honest, [&] {
     for (int i = 0; i < 9; ++i) silent.push_back(std::make_unique<RawSocket>(server.port()));
-    std::this_thread::sleep_for(300ms);  // all accepted: the table is full
+    // All accepted, the table full, before the newcomer: the honest viewer is client 1, these 2 to 10.
+    server.wait_for_log("client 10 connected", 5s);
     BackgroundClient newcomer(server.port(), false, "newcomer");
     welcomed = newcomer.wait_until([](const ClientState& s) { return s.welcomed; }, 5s);
     oldest_closed = silent.front()->read_until_closed(oldest, 3s);
@@ -243,7 +239,8 @@ TEST_CASE("abuse: an address's connections without Hello are capped: beyond it t
   std::vector<std::unique_ptr<RawSocket>> silent;
   for (int i = 0; i < 5; ++i) {
     silent.push_back(std::make_unique<RawSocket>(server.port()));
-    std::this_thread::sleep_for(50ms);  // accepted in this order
+    // Accepted in this order, so the oldest are the first two: client ids count from 1.
+    server.wait_for_log("client " + std::to_string(i + 1) + " connected", 5s);
   }
   int evicted = 0, kept = 0;
   for (int i = 0; i < 5; ++i) {

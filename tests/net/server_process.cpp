@@ -1,12 +1,8 @@
 #include "server_process.h"
 
-#include <arpa/inet.h>
 #include <fcntl.h>
-#include <netinet/in.h>
-#include <poll.h>
 #include <signal.h>
 #include <spawn.h>
-#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -34,6 +30,15 @@ std::string read_file(const std::string& path) {
 }
 }  // namespace
 
+bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds timeout, std::chrono::milliseconds poll) {
+  const Clock::time_point deadline = Clock::now() + timeout;
+  while (!done()) {
+    if (Clock::now() > deadline) return false;
+    std::this_thread::sleep_for(poll);
+  }
+  return true;
+}
+
 ServerProcess::ServerProcess(const std::vector<std::string>& args, const std::vector<std::string>& launcher) {
   static int counter = 0;
   log_path_ = (std::filesystem::temp_directory_path() /
@@ -60,28 +65,43 @@ ServerProcess::ServerProcess(const std::vector<std::string>& args, const std::ve
   posix_spawn_file_actions_addopen(&files, STDERR_FILENO, log_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
   const int spawned = posix_spawn(&pid_, argv[0], &files, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&files);
-  if (spawned != 0) throw std::runtime_error("cannot start " + argv_text[0]);
-
-  const std::regex listening("listening on 127\\.0\\.0\\.1:([0-9]+)");
-  const std::regex web_viewer("web viewer on http://127\\.0\\.0\\.1:([0-9]+)/");
-  const Clock::time_point deadline = Clock::now() + std::chrono::seconds(15);
-  while (Clock::now() < deadline && running()) {
-    std::smatch m, w;
-    const std::string text = log();
-    if (std::regex_search(text, m, listening) && (!web || std::regex_search(text, w, web_viewer))) {
-      port_ = static_cast<std::uint16_t>(std::stoi(m[1]));
-      if (web) web_port_ = static_cast<std::uint16_t>(std::stoi(w[1]));
-      return;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  if (spawned != 0) {
+    pid_ = -1;  // unspecified on failure; discard() must not signal it
+    discard();  // the child may have created the log before its exec failed
+    throw std::runtime_error("cannot start " + argv_text[0]);
   }
-  throw std::runtime_error("fishtank-server did not start listening; its log:\n" + log());
+  // A throwing constructor runs no destructor: without this a server that never
+  // listened would run on until its --duration.
+  try {
+    wait_until_listening(web);
+  } catch (...) {
+    discard();
+    throw;
+  }
 }
 
-ServerProcess::~ServerProcess() {
+void ServerProcess::wait_until_listening(bool web) {
+  const std::regex listening("listening on 127\\.0\\.0\\.1:([0-9]+)");
+  const std::regex web_viewer("web viewer on http://127\\.0\\.0\\.1:([0-9]+)/");
+  bool listens = false;
+  const auto listening_now = [&] {
+    const std::string text = log();
+    std::smatch m, w;
+    if (!std::regex_search(text, m, listening) || (web && !std::regex_search(text, w, web_viewer))) return false;
+    port_ = static_cast<std::uint16_t>(std::stoi(m[1]));
+    if (web) web_port_ = static_cast<std::uint16_t>(std::stoi(w[1]));
+    listens = true;
+    return true;
+  };
+  wait_until([&] { return !running() || listening_now(); }, std::chrono::seconds(15), std::chrono::milliseconds(20));
+  if (!listens) throw std::runtime_error("fishtank-server did not start listening; its log:\n" + log());
+}
+
+void ServerProcess::discard() {
   if (running()) {
     kill(pid_, SIGKILL);
     waitpid(pid_, nullptr, 0);
+    reaped_ = true;
   }
   std::error_code ignored;
   // scripts/test-asan: a server's sanitizer report fails the run even when the
@@ -96,8 +116,11 @@ ServerProcess::~ServerProcess() {
   std::filesystem::remove(log_path_, ignored);
 }
 
+ServerProcess::~ServerProcess() { discard(); }
+
 bool ServerProcess::running() {
-  if (reaped_) return false;
+  // pid -1 would make waitpid reap any child of the test.
+  if (reaped_ || pid_ <= 0) return false;
   int status = 0;
   if (waitpid(pid_, &status, WNOHANG) == pid_) {
     reaped_ = true;
@@ -116,6 +139,10 @@ long ServerProcess::rss_kb() const {
 
 std::string ServerProcess::log() const { return read_file(log_path_); }
 
+bool ServerProcess::wait_for_log(const std::string& text, std::chrono::milliseconds timeout) const {
+  return wait_until([&] { return log().find(text) != std::string::npos; }, timeout);
+}
+
 int ServerProcess::terminate() {
   if (!running()) return exit_status_;
   kill(pid_, SIGTERM);
@@ -128,62 +155,6 @@ int ServerProcess::terminate() {
     return -1;
   }
   return exit_status_;
-}
-
-RawSocket::RawSocket(std::uint16_t port, int receive_buffer) {
-  fd_ = socket(AF_INET, SOCK_STREAM, 0);
-  if (receive_buffer > 0) setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &receive_buffer, sizeof receive_buffer);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_port = htons(port);
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (connect(fd_, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0)
-    throw std::runtime_error("cannot connect to 127.0.0.1:" + std::to_string(port));
-}
-
-RawSocket::~RawSocket() { close(); }
-
-void RawSocket::send(const std::vector<std::uint8_t>& bytes) {
-  std::size_t sent = 0;
-  while (sent < bytes.size()) {
-    const ssize_t n = ::send(fd_, bytes.data() + sent, bytes.size() - sent, MSG_NOSIGNAL);
-    if (n <= 0) throw std::runtime_error("send failed");
-    sent += static_cast<std::size_t>(n);
-  }
-}
-
-bool RawSocket::read_until_closed(std::vector<std::uint8_t>& out, std::chrono::milliseconds timeout) {
-  const Clock::time_point deadline = Clock::now() + timeout;
-  std::uint8_t buffer[65536];
-  while (Clock::now() < deadline) {
-    pollfd p{fd_, POLLIN, 0};
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
-    if (poll(&p, 1, static_cast<int>(std::max<long>(1, left.count()))) <= 0) continue;
-    const ssize_t n = recv(fd_, buffer, sizeof buffer, 0);
-    if (n <= 0) return true;  // closed (or reset) by the server
-    out.insert(out.end(), buffer, buffer + n);
-  }
-  return false;
-}
-
-bool RawSocket::read_until(const std::string& text, std::vector<std::uint8_t>& out, std::chrono::milliseconds timeout) {
-  const Clock::time_point deadline = Clock::now() + timeout;
-  std::uint8_t buffer[4096];
-  while (std::search(out.begin(), out.end(), text.begin(), text.end()) == out.end()) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
-    if (left.count() <= 0) return false;
-    pollfd p{fd_, POLLIN, 0};
-    if (poll(&p, 1, static_cast<int>(left.count())) <= 0) continue;
-    const ssize_t n = recv(fd_, buffer, sizeof buffer, 0);
-    if (n <= 0) return false;
-    out.insert(out.end(), buffer, buffer + n);
-  }
-  return true;
-}
-
-void RawSocket::close() {
-  if (fd_ >= 0) ::close(fd_);
-  fd_ = -1;
 }
 
 }  // namespace fishtank::test

@@ -9,15 +9,24 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
+// Its users drive the server with raw bytes too: they get RawSocket from here.
+#include "raw_socket.h"
+
 namespace fishtank::test {
+
+// Polls done() every `poll` until it holds (true) or `timeout` passes (false).
+bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds timeout,
+                std::chrono::milliseconds poll = std::chrono::milliseconds(50));
 
 class ServerProcess {
  public:
   // Starts fishtank-server --bind 127.0.0.1 --port 0 plus `args` (and --threads 1
-  // unless they give --threads), and waits (at most 15 s) until it listens. Throws when it does not.
+  // unless they give --threads), and waits (at most 15 s) until it listens. Throws when it does not,
+  // leaving neither the server running nor its log behind.
   // `launcher` goes before the server's path, e.g. {"/usr/bin/prlimit", "--nofile=40", "--"}.
   explicit ServerProcess(const std::vector<std::string>& args, const std::vector<std::string>& launcher = {});
   // SIGKILL if still running.
@@ -31,37 +40,24 @@ class ServerProcess {
   // Resident memory of the server now, in kB (0 when unknown).
   long rss_kb() const;
   std::string log() const;
+  // Waits (at most `timeout`) until the log has `text`; false when it did not come.
+  bool wait_for_log(const std::string& text, std::chrono::milliseconds timeout) const;
   // SIGTERM, then waits at most 10 s; the exit status, or -1 when it had to be killed.
   int terminate();
 
  private:
+  // Until the log shows the port(s) listening; throws when the server exits or 15 s pass.
+  void wait_until_listening(bool web);
+  // SIGKILL and reap the server if it runs, then remove its log (first copied for
+  // scripts/test-asan when it holds a sanitizer report).
+  void discard();
+
   pid_t pid_ = -1;
   std::string log_path_;
   std::uint16_t port_ = 0;
   std::uint16_t web_port_ = 0;
   bool reaped_ = false;
   int exit_status_ = -1;
-};
-
-// A plain blocking socket to 127.0.0.1, for bytes no well-behaved client sends.
-class RawSocket {
- public:
-  // receive_buffer > 0 shrinks the kernel's receive buffer before connecting.
-  explicit RawSocket(std::uint16_t port, int receive_buffer = 0);
-  ~RawSocket();
-  RawSocket(const RawSocket&) = delete;
-  RawSocket& operator=(const RawSocket&) = delete;
-
-  void send(const std::vector<std::uint8_t>& bytes);
-  void send_text(const std::string& text) { send(std::vector<std::uint8_t>(text.begin(), text.end())); }
-  // Reads until what was read contains `text` (true) or `timeout` passes or the peer closes (false).
-  bool read_until(const std::string& text, std::vector<std::uint8_t>& out, std::chrono::milliseconds timeout);
-  // Reads until the peer closes or `timeout` passes; true when it closed.
-  bool read_until_closed(std::vector<std::uint8_t>& out, std::chrono::milliseconds timeout);
-  void close();
-
- private:
-  int fd_ = -1;
 };
 
 }  // namespace fishtank::test

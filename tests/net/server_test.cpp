@@ -26,6 +26,7 @@ using test::first_error_code;
 using test::frame_with_length;
 using test::RawSocket;
 using test::ServerProcess;
+using test::wait_until;
 using Clock = std::chrono::steady_clock;
 namespace asio = boost::asio;
 
@@ -80,16 +81,6 @@ std::vector<double> measure_rates(Clients& clients, const std::vector<std::share
   std::vector<double> rates;
   for (std::size_t i = 0; i < of.size(); ++i) rates.push_back((of[i]->stats().snapshots - before[i]) / seconds);
   return rates;
-}
-
-// Polls ready() until it holds (true) or timeout passes (false).
-bool wait_for(const std::function<bool()>& ready, std::chrono::milliseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (!ready()) {
-    if (std::chrono::steady_clock::now() > deadline) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  return true;
 }
 
 // The server's status lines ("t = ... s  balls ..."), oldest first.
@@ -502,8 +493,7 @@ TEST_CASE("bad bytes from one client: Error and disconnect for it - the server a
     CHECK(error_codes(got) == std::vector<std::string>{"malformed_frame"});
     // The socket kept open, the server waits out its grace: the physics thread's Welcome for the
     // Hello comes meanwhile, and is not written after the farewell (a write there failed: "Broken pipe").
-    REQUIRE(wait_for([&] { return server.log().find("('hello-then-garbage') closed: ") != std::string::npos; },
-                     std::chrono::seconds(5)));
+    REQUIRE(server.wait_for_log("('hello-then-garbage') closed: ", std::chrono::seconds(5)));
     CHECK_THAT(server.log(), Catch::Contains("('hello-then-garbage') closed: disconnected by the server"));
   }
   SECTION("half a frame, then the client disconnects") {
@@ -657,8 +647,7 @@ TEST_CASE("a client the server drops says so and stops, instead of waiting out i
   client::Summary summary;
   std::thread run([&] { summary = client::run_script(script); });
   // Dropped once welcomed: the server logs the Welcome as it sends it, then the client has a second to read it.
-  const bool welcomed = wait_for([&] { return server.log().find("welcomed as observer") != std::string::npos; },
-                                 std::chrono::seconds(10));
+  const bool welcomed = server.wait_for_log("welcomed as observer", std::chrono::seconds(10));
   std::this_thread::sleep_for(std::chrono::milliseconds(1000));
   const auto dropped_at = std::chrono::steady_clock::now();
   server.terminate();
@@ -761,19 +750,19 @@ TEST_CASE("fishtank-client stops at --duration with connections still unopened, 
 
 TEST_CASE("no snapshot is captured or coded while nobody watches, and none once the last viewer has left", "[net]") {
   ServerProcess server({"--balls", "300", "--status-interval", "0.25"});
-  REQUIRE(wait_for([&] { return status_lines(server).size() >= 4; }, std::chrono::seconds(10)));
+  REQUIRE(wait_until([&] { return status_lines(server).size() >= 4; }, std::chrono::seconds(10)));
   for (const std::string& line : status_lines(server)) CHECK(codes_nothing(line));
 
   Clients clients(server.port());
   auto watcher = clients.add(false);
   REQUIRE(clients.wait_until([&] { return watcher->stats().snapshots > 10; }, std::chrono::seconds(10)));
-  REQUIRE(wait_for([&] { return !codes_nothing(status_lines(server).back()); }, std::chrono::seconds(5)));
+  REQUIRE(wait_until([&] { return !codes_nothing(status_lines(server).back()); }, std::chrono::seconds(5)));
 
   watcher->close();
-  REQUIRE(wait_for([&] { return server.log().find(") closed: ") != std::string::npos; }, std::chrono::seconds(5)));
+  REQUIRE(server.wait_for_log(") closed: ", std::chrono::seconds(5)));
   const std::size_t after_leaving = status_lines(server).size();
   // The window the viewer left in may have coded some; the two after it code none.
-  REQUIRE(wait_for([&] { return status_lines(server).size() >= after_leaving + 3; }, std::chrono::seconds(10)));
+  REQUIRE(wait_until([&] { return status_lines(server).size() >= after_leaving + 3; }, std::chrono::seconds(10)));
   const std::vector<std::string> lines = status_lines(server);
   CHECK(codes_nothing(lines[lines.size() - 1]));
   CHECK(codes_nothing(lines[lines.size() - 2]));

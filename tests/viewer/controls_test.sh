@@ -18,9 +18,10 @@ start_server "$log" --balls 300 --threads 1 --status-interval 0.25
 
 # Inside the X session: start the viewer, wait for its window and its welcome,
 # then type each key and wait (at most 20 s) for the server's status line to show it.
-export SERVER_LOG=$log VIEWER=$viewer PORT=$port
+export SERVER_LOG=$log VIEWER=$viewer PORT=$port HELPERS=$helpers
 cd "$out/work"
 timeout 200 xvfb-run -a -s "-screen 0 1280x1024x24" bash -euo pipefail -c '
+  source "$HELPERS"
   "$VIEWER" --connect "127.0.0.1:$PORT" --max-fps 10 2>viewer.log &
   viewer_pid=$!
   expect_status() {  # pattern, what it means
@@ -31,10 +32,10 @@ timeout 200 xvfb-run -a -s "-screen 0 1280x1024x24" bash -euo pipefail -c '
     echo "FAILED: $2: no status line matching \"$1\""; tail -n 5 "$SERVER_LOG"; exit 1
   }
   window=$(xdotool search --sync --name Fishtank | head -n 1)
-  for _ in $(seq 200); do grep -q "welcomed with player sphere" "$SERVER_LOG" && break; sleep 0.1; done
+  wait_for_log "$SERVER_LOG" "welcomed with player sphere" 20 "the server to welcome the viewer with a player sphere"
   # The viewer ignores sandbox keys until it has a snapshot: deltas (frames sent, no keyframe) mean it
   # acknowledged one.
-  for _ in $(seq 200); do grep -q "[1-9][0-9]* B mean, 0 keyframes" "$SERVER_LOG" && break; sleep 0.1; done
+  wait_for_log "$SERVER_LOG" "[1-9][0-9]* B mean, 0 keyframes" 20 "the server to send the viewer deltas"
   xdotool windowfocus "$window"
   xdotool key bracketleft
   expect_status "time scale set to x0.50" "[ slows the clock to 0.5"
@@ -45,7 +46,7 @@ timeout 200 xvfb-run -a -s "-screen 0 1280x1024x24" bash -euo pipefail -c '
   xdotool key p
   expect_status "scene dam-break  paused" "P pauses"
   xdotool key F12
-  for _ in $(seq 100); do grep -q "screenshot saved: " viewer.log && break; sleep 0.1; done
+  wait_for_log viewer.log "screenshot saved: " 10 "the viewer to save its F12 screenshot"
   xdotool key Escape
   wait "$viewer_pid"
 '

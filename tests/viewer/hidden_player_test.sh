@@ -20,20 +20,21 @@ wait_settled "$log"
 
 # The sphere moves at 8 m/s and stops at the floor: 2.5 s of Q take it there from the tank's
 # centre, and 7 s do even with the physics in slow motion at x0.4 on a busy machine.
-export SERVER_LOG=$log VIEWER=$viewer PORT=$port
+export SERVER_LOG=$log VIEWER=$viewer PORT=$port HELPERS=$helpers
 cd "$out/work"
 timeout 150 xvfb-run -a -s "-screen 0 1280x1024x24" bash -euo pipefail -c '
+  source "$HELPERS"
   "$VIEWER" --connect "127.0.0.1:$PORT" --no-hud 2>viewer.log &
   viewer_pid=$!
   window=$(xdotool search --sync --name Fishtank | head -n 1)
-  for _ in $(seq 200); do grep -q "welcomed with player sphere" "$SERVER_LOG" && break; sleep 0.1; done
+  wait_for_log "$SERVER_LOG" "welcomed with player sphere" 20 "the server to welcome the viewer with a player sphere"
   xdotool windowfocus "$window"
   xdotool keydown q
   sleep 7
   xdotool keyup q
   sleep 1
   xdotool key F12
-  for _ in $(seq 100); do grep -q "screenshot saved: " viewer.log && break; sleep 0.1; done
+  wait_for_log viewer.log "screenshot saved: " 10 "the viewer to save its F12 screenshot"
   xdotool key Escape
   wait "$viewer_pid"
 '

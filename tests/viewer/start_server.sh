@@ -3,8 +3,13 @@
 # LOG, stops it when the test exits, and sets $port (exit 1 when it does not listen).
 # wait_settled LOG waits until every ball is poured and has had 4 s to fall.
 # need_tools TOOL... skips the test (exit 77) where one is not installed.
+# wait_for_log FILE PATTERN SECONDS WHAT waits until a line of FILE matches
+# PATTERN (grep's), or says it waited in vain for WHAT and exits 1.
 # scripts/fishtank_tools.py reads the port, as it does for every script.
 tools="$(dirname "${BASH_SOURCE[0]}")/../../scripts/fishtank_tools.py"
+# The shells under xvfb-run source this file again by this path: functions
+# exported with export -f do not pass through xvfb-run's /bin/sh.
+helpers=$(realpath "${BASH_SOURCE[0]}")
 need_tools() {
   local tool
   for tool in "$@"; do
@@ -44,5 +49,18 @@ wait_settled() {
   done
   echo "the server did not finish pouring its balls within 120 s:"
   cat "$log"
+  exit 1
+}
+
+# A wait that fails where it waited, naming what for, rather than letting a later step
+# fail with a message that misleads.
+wait_for_log() {
+  local file=$1 pattern=$2 seconds=$3 what=$4
+  for _ in $(seq $((seconds * 10))); do
+    grep -q -- "$pattern" "$file" 2>/dev/null && return 0
+    sleep 0.1
+  done
+  echo "FAILED: waited $seconds s for $what: no line matching \"$pattern\" in $file; its last lines:"
+  tail -n 20 "$file" 2>/dev/null || true
   exit 1
 }
