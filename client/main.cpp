@@ -1,5 +1,6 @@
 // fishtank-client: a scripted test and load client (see --help).
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -95,6 +96,12 @@ int main(int argc, char** argv) {
   }
   if (s.dropped > 0) {
     std::cerr << "fishtank-client: the server dropped " << s.dropped << " of " << s.clients << " connections\n";
+    return 1;
+  }
+  // player_limit only says a client observes while it waits in line; any other Error refused what was asked.
+  if (std::any_of(s.error_codes.begin(), s.error_codes.end(),
+                  [](const std::string& c) { return c != "player_limit"; })) {
+    std::cerr << "fishtank-client: the server refused what was asked (its reasons are above)\n";
     return 1;
   }
   return 0;

@@ -9,6 +9,7 @@
 #include "common/host_port.h"
 #include "common/number_text.h"
 #include "common/pending_connections.h"
+#include "common/scene_names.h"
 #include "protocol/frame_codec.h"
 
 namespace fishtank::client {
@@ -124,8 +125,10 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
                 std::to_string(step));
   if (!vm["time-scale"].empty() && !(time_scale >= protocol::kMinTimeScale && time_scale <= protocol::kMaxTimeScale))
     return fail("--time-scale must be between 0.1 and 1, got " + number_text(time_scale));
-  if (!vm["scene"].empty() && (scene.empty() || scene.size() > protocol::kMaxSceneNameBytes))
-    return fail("--scene wants a scene's name (tank, wide, dam-break or drop)");
+  if (!vm["scene"].empty() && !is_scene_name(scene))
+    return fail("--scene: unknown scene '" + scene + "'; the scenes are " + scene_names_text());
+  if (!vm["scene"].empty() && reset) return fail("--scene starts that scene from its start already; drop --reset");
+  if (!vm["for"].defaulted() && vm["move"].empty()) return fail("--for goes with --move (how long to move)");
   if (!vm["seed"].empty() && seed < 0) return fail("--seed must be >= 0, got " + std::to_string(seed));
   if (!vm["seed"].empty() && vm["scene"].empty() && !reset) return fail("--seed goes with --reset or --scene");
   if (!vm["scene"].empty()) o.script.scene = scene;

@@ -5,7 +5,8 @@ its default count becomes what fits; a port in use names --port and
 --port 0, with no "Ctrl-C stops" banner first; a final-state path that cannot
 be written is refused before the run, not after it; fishtank-client pointed
 where nothing listens gives the command that starts a server there, and one
-whose connections are not all welcomed says so and fails; a server
+whose connections are not all welcomed says so and fails, as does one whose command the
+server refuses; a server
 bound to every address gives the others an address that reaches it, not
 0.0.0.0; a server given one core (taskset) starts one thread, not one per
 core installed; a second Ctrl-C ends a server that is writing its final files."""
@@ -154,6 +155,27 @@ def test_a_client_whose_connections_are_not_all_welcomed_says_how_many_and_fails
               for e in summary["error_messages"]]
     assert sum(counts) == summary["errors"] and len(set(summary["error_messages"])) == len(counts), summary
     assert any(e.startswith("player_limit: ") and e.endswith(" (2 connections)") for e in summary["error_messages"])
+
+
+def test_a_client_whose_command_the_server_refuses_fails_but_one_waiting_in_line_for_a_sphere_does_not():
+    server = subprocess.Popen([SERVER, "--port", "0", "--no-web", "--threads", "1", "--balls", "10",
+                               "--max-players", "1", "--duration", "20"],
+                              stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True)
+    try:
+        line = server.stderr.readline()
+        while line and not line.startswith("listening on"):
+            line = server.stderr.readline()
+        address = ["--connect", f"127.0.0.1:{int(line.strip().rsplit(':', 1)[1])}", "--duration", "1"]
+        step = subprocess.run([CLIENT, *address, "--step", "10"], capture_output=True, text=True, timeout=30)
+        in_line = subprocess.run([CLIENT, *address, "--clients", "2"], capture_output=True, text=True, timeout=30)
+    finally:
+        server.send_signal(signal.SIGTERM)
+        server.wait(timeout=10)
+    assert step.returncode == 1, step.stdout + step.stderr
+    assert "error: not_paused: " in step.stdout
+    assert step.stderr.strip() == "fishtank-client: the server refused what was asked (its reasons are above)"
+    assert in_line.returncode == 0, in_line.stdout + in_line.stderr
+    assert "error: player_limit: " in in_line.stdout
 
 
 def test_a_server_that_takes_other_machines_gives_them_an_address_that_reaches_it_not_0_0_0_0():

@@ -70,6 +70,9 @@ def test_a_value_with_one_dash_is_still_a_value(tmp_path):
     (["--reset", "--seed", "-1"], "--seed must be >= 0, got -1"),
     (["--move", "1,2"], "--move wants three finite numbers x,y,z, got '1,2'"),
     (["--pause", "--resume"], "--pause and --resume contradict each other; give one"),
+    (["--scene", "Drop"], "--scene: unknown scene 'Drop'; the scenes are tank, wide, dam-break and drop"),
+    (["--scene", "tank", "--reset"], "--scene starts that scene from its start already; drop --reset"),
+    (["--for", "2"], "--for goes with --move (how long to move)"),
 ])
 def test_a_client_value_out_of_range_is_refused_with_its_range_and_the_value_given(flags, said):
     run = subprocess.run([os.path.join(BUILD, "client", "fishtank-client"), *flags], capture_output=True, text=True,
