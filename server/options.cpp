@@ -201,6 +201,23 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
     for (const char* flag : {"record-every", "record-from", "record-constant-count"})
       if (!vm[flag].defaulted())
         return fail(std::string("--") + flag + " shapes a recording: give --record FILE too, or drop it");
+  // A flag of the other mode would go unused without a word.
+  const auto given = [&vm](const po::options_description& group, const char* except) -> std::string {
+    for (const auto& option : group.options())
+      if (option->long_name() != except && vm.count(option->long_name()) && !vm[option->long_name()].defaulted())
+        return "--" + option->long_name();
+    return "";
+  };
+  if (const std::string flag = given(bench, "bench"); !o.bench && !flag.empty())
+    return fail(flag + " shapes a benchmark: give --bench too, or drop it");
+  if (o.bench)
+    for (const po::options_description* group : {&network, &guard})
+      if (const std::string flag = given(*group, ""); !flag.empty())
+        return fail(flag + " is for clients, and --bench runs without a network: drop it");
+  if (o.bench)
+    for (const char* flag : {"duration", "status-interval"})
+      if (!vm[flag].defaulted())
+        return fail(std::string("--") + flag + " paces the server, and --bench runs unpaced for --steps: drop it");
   if (max_balls < 0 || max_balls > 10'000'000)
     return fail("--max-balls must be between 0 and 10000000, got " + std::to_string(max_balls));
   if (!std::isfinite(o.duration) || o.duration < 0.0)

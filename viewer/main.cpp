@@ -23,11 +23,11 @@ int main(int argc, char** argv) {
       "Usage: fishtank-viewer [--connect host:port] [--fullscreen] [--observer]\n"
       "Keys: H shows every control in the window.\n\nOptions");
   flags.add_options()                                                                                   //
-      ("help", "print this help and exit")                                                              //
+      ("help,h", "print this help and exit")                                                            //
       ("connect", po::value(&connect), "server to connect to, host:port (default 127.0.0.1:7878)")      //
       ("fullscreen", po::bool_switch(&opt.fullscreen), "start in full screen (F11 toggles)")            //
       ("observer", po::bool_switch(&opt.observer), "watch only: no player sphere of our own")           //
-      ("no-hud", "start with the statistics and live plots hidden (F1, F2 toggle)")                      //
+      ("no-hud", "start with the statistics and live plots hidden (F1, F2 toggle)")                     //
       ("outline", po::bool_switch(&opt.tank_outline), "start with the tank's edges shown (T toggles)")  //
       ("screenshot", po::value(&opt.screenshot),
        "render --frames frames after the first snapshot, save the last "
@@ -60,6 +60,8 @@ int main(int argc, char** argv) {
   opt.host = address->host;
   opt.port = std::to_string(address->port);
   if (opt.frames < 1) return refuse("--frames must be at least 1, got " + std::to_string(opt.frames));
+  if (vm.count("frames") && opt.screenshot.empty())
+    return refuse("--frames counts the frames before --screenshot: give --screenshot FILE too, or drop it");
   if (!opt.screenshot.empty())
     if (const std::string why = fishtank::check_writable_file(opt.screenshot); !why.empty())
       return refuse("--screenshot " + opt.screenshot + ": " + why);

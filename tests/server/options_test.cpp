@@ -161,7 +161,7 @@ TEST_CASE("every bad value is refused with a message naming it and exit code 2",
       {{"--duration", "nan"}, "--duration"},
       {{"--duration", "-1"}, "--duration"},
       {{"--status-interval", "0"}, "--status-interval"},
-      {{"--settle-time", "inf"}, "--settle-time"},
+      {{"--bench", "--settle-time", "inf"}, "--settle-time must be between"},
       {{"--bench", "--scene", "cube"}, "unknown scene 'cube'"},
       {{"--scene", "cube"}, "unknown scene 'cube'; the scenes are tank, wide, dam-break and drop"},
       {{"--control", "observers"}, "--control must be players, everyone or nobody"},
@@ -213,6 +213,11 @@ TEST_CASE("every bad value is refused with a message naming it and exit code 2",
       {{"--dump", "--balls", "10"}, "--dump wants a value, got the flag '--balls'"},
       {{"--dt=--x"}, "--dt wants a value, got the flag '--x'"},
       {{"--bench", "--balls", "0"}, "--bench times balls: give --balls 1 or more"},
+      // A flag of the other mode would go unused.
+      {{"--steps", "100"}, "--steps shapes a benchmark: give --bench too, or drop it"},
+      {{"--bench", "--port", "9000"}, "--port is for clients, and --bench runs without a network: drop it"},
+      {{"--bench", "--max-connections", "5"}, "--max-connections is for clients"},
+      {{"--bench", "--duration", "5"}, "--duration paces the server, and --bench runs unpaced for --steps"},
   };
   for (const Bad& b : bad) {
     std::string line;

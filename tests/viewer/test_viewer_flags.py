@@ -18,6 +18,7 @@ VIEWER = os.path.join(os.environ["FISHTANK_BUILD_DIR"], "viewer", "fishtank-view
     (["--connect", "127.0.0.1:99999"], "--connect wants host:port with a port 1 .. 65535, got '127.0.0.1:99999'"),
     (["--connect", "127.0.0.1:abc"], "--connect wants host:port with a port 1 .. 65535, got '127.0.0.1:abc'"),
     (["--frames", "0"], "--frames must be at least 1, got 0"),
+    (["--frames", "5"], "--frames counts the frames before --screenshot: give --screenshot FILE too, or drop it"),
     (["--max-fps", "-1"], "--max-fps must be between 0 (no cap) and"),
     (["--duration", "-2"], "--duration must be a number of seconds >= 0 (0: stay open), got -2"),
     (["--duration", "soon"], "the argument ('soon') for option '--duration' is invalid"),
