@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "common/number_text.h"
+
 namespace fishtank {
 
 std::string TrajectoryRecorder::open() {
@@ -14,8 +16,19 @@ std::string TrajectoryRecorder::at_step_boundary(const World& world) {
 }
 
 std::string TrajectoryRecorder::finish(const World& world) {
+  if (options_.path.empty()) return "";
   const std::string note = last_step_ == world.steps() ? "" : write(world);
-  return failed_ ? note : closed(note);
+  if (failed_) return note;
+  if (frames() > 0) return closed(note);
+  // An empty file is not what was asked for: say why, and fail like a write error.
+  failed_ = true;
+  char why[160];
+  std::snprintf(why, sizeof why, "no frame recorded: the run ended at t = %.3f s with %u balls", world.time(),
+                world.ball_count());
+  const std::string reason =
+      world.ball_count() == 0 ? "" : ", before --record-from " + number_text(options_.from) + " s";
+  const std::string error = closed("");
+  return error.empty() ? why + reason + "; " + options_.path + " is empty" : error;
 }
 
 std::string TrajectoryRecorder::closed(const std::string& note) {

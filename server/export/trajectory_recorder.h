@@ -35,7 +35,7 @@ class TrajectoryRecorder {
   // The final state as the last frame, unless it was just written. Returns as above.
   std::string finish(const World& world);
 
-  bool failed() const { return failed_; }  // a write failed
+  bool failed() const { return failed_; }  // a write failed, or the run ended before a frame was due
   std::uint64_t frames() const { return writer_.frames(); }
 
  private:

@@ -109,6 +109,20 @@ TEST_CASE("no frame is recorded before --record-from's simulated second", "[expo
   for (std::size_t f = 1; f < frames.size(); ++f) CHECK(frames[f].step - frames[f - 1].step == 20);
 }
 
+TEST_CASE("a run that ends before --record-from's second records nothing, says why and fails", "[export][record]") {
+  World world(PhysicsParams{}, kSseKernels, 1, 3);
+  world.add_balls(30);
+  const auto path = temp_file("fishtank-record-too-late.lammpstrj");
+  TrajectoryRecorder recorder({path.string(), 20, 5.0, false});
+  REQUIRE(recorder.open().empty());
+  CHECK(run(world, recorder, 300).empty());
+  const std::string note = recorder.finish(world);
+  CHECK_THAT(note, Catch::StartsWith("no frame recorded: the run ended at t = 0.3") &&
+                       Catch::EndsWith("s with 30 balls, before --record-from 5 s; " + path.string() + " is empty"));
+  CHECK(recorder.failed());
+  CHECK(recorder.frames() == 0);
+}
+
 TEST_CASE("a constant-count recording starts once the pour is in and ends, saying why, when the count changes",
           "[export][record]") {
   World world(PhysicsParams{}, kSseKernels, 1, 3);
