@@ -96,7 +96,7 @@ int run_bench(const fishtank::ServerOptions& o) {
   fishtank::BenchSpec bench = o.bench_spec;
   const std::string& scene = bench.scene.name;
   const std::uint32_t capacity = fishtank::scene_capacity(world, scene);
-  const bool capped = o.max_balls > 0 && o.max_balls < capacity;  // --max-balls bounds every scene
+  const bool capped = o.max_balls > 0 && o.max_balls <= capacity;  // --max-balls bounds every scene
   if (const std::uint32_t holds = capped ? o.max_balls : capacity; bench.scene.balls > holds) {
     if (o.balls_given) {
       std::cerr << "fishtank-server: --bench refuses --balls " << bench.scene.balls << ": "

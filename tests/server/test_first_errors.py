@@ -56,11 +56,12 @@ def test_bench_on_a_scene_that_holds_fewer_says_what_it_holds_and_that_count_run
 
 
 def test_bench_keeps_to_max_balls_on_a_placed_scene_too():
-    run = subprocess.run([SERVER, "--bench", "--scene", "wide", "--balls", "1000", "--max-balls", "500"],
-                         capture_output=True, text=True, timeout=30)
-    assert run.returncode == 2 and run.stdout == ""
-    assert run.stderr.strip() == ("fishtank-server: --bench refuses --balls 1000: --max-balls lets in at most 500; "
-                                  "use --balls 500 or fewer"), run.stderr
+    for scene in ("wide", "tank"):  # the tank's refusal sent readers to --scene wide, which --max-balls caps too
+        run = subprocess.run([SERVER, "--bench", "--scene", scene, "--balls", "1000", "--max-balls", "500"],
+                             capture_output=True, text=True, timeout=30)
+        assert run.returncode == 2 and run.stdout == ""
+        assert run.stderr.strip() == ("fishtank-server: --bench refuses --balls 1000: --max-balls lets in at most "
+                                      "500; use --balls 500 or fewer"), run.stderr
     quick = ["--steps", "10", "--windows", "1", "--settle-time", "0.05"]
     default = subprocess.run([SERVER, "--bench", "--scene", "wide", "--max-balls", "500", *quick],
                              capture_output=True, text=True, timeout=120)
