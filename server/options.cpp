@@ -121,7 +121,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   po::options_description physics("Physics");
   char stiffness_help[96];
   std::snprintf(stiffness_help, sizeof stiffness_help,
-                "contact spring constant k, N/m, at least %.0f (softer piles sink through the floor)",
+                "contact spring constant k, N/m, at least %.1f (softer piles sink through the floor)",
                 double(softest_stiffness(defaults)));
   physics.add_options()("stiffness", po::value(&o.physics.stiffness)->default_value(defaults.stiffness, "25000"),
                         stiffness_help)("restitution",
@@ -141,7 +141,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "windows", po::value(&windows)->default_value(windows),
       "the timed steps are split into this many windows; rates are their median")(
       "settle-time", po::value(&settle_time)->default_value(0.0),
-      "most simulated seconds to wait for rest, 1e-6 J per ball (0: 300 for tank, 4 for wide)");
+      "most simulated seconds to wait for rest, 1e-6 J per ball (0: 4 for wide, 300 for the other scenes)");
 
   po::options_description all;
   all.add(general).add(network).add(guard).add(physics).add(bench).add(output);

@@ -43,7 +43,7 @@ TEST_CASE("unstable or absurd parameters are refused with a reason", "[params]")
     CHECK(validate(p).find("unstable") != std::string::npos);
   }
   SECTION("stiffness too soft for a pile under gravity, and the least allowed is accepted") {
-    // A column of 3 kg balls 40 high weighs 13.3 x 3 x 9.81 N: under 0.5 in, k >= 785 N/m.
+    // A column of 3 kg balls 40 high weighs 13.3 x 3 x 9.81 N: under 0.5 in, k >= 784.8 N/m.
     CHECK(softest_stiffness(p) == Approx(40.0 / 3.0 * 3.0 * 9.81 / 0.5));
     p.stiffness = 0.99f * softest_stiffness(p);
     const std::string why = validate(p);
