@@ -9,6 +9,7 @@
 
 #include "client/options.h"
 #include "common/host_port.h"
+#include "common/number_text.h"
 #include "common/server_hint.h"
 
 int main(int argc, char** argv) {
@@ -38,7 +39,7 @@ int main(int argc, char** argv) {
         else
           std::cout << "t " << r.t << " s: " << r.snapshots << " snapshots (" << r.keyframes << " in full), " << r.bytes
                     << " bytes, " << bytes_per_ball << " bytes per ball per snapshot, rtt "
-                    << (r.rtt_ms ? std::to_string(*r.rtt_ms) + " ms" : "(no Pong came back)") << "\n";
+                    << (r.rtt_ms ? fishtank::number_text(*r.rtt_ms) + " ms" : "(no Pong came back)") << "\n";
       });
   if (!s.connect_error.empty()) {
     std::cerr << "fishtank-client: no connection to "

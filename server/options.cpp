@@ -5,6 +5,7 @@
 #include <boost/program_options.hpp>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <sstream>
 #include <vector>
 
@@ -247,6 +248,11 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
     return fail("--web-port must be between 0 and 65535, got " + std::to_string(web_port));
   if (no_web && (!vm["web-port"].defaulted() || !vm["web-root"].defaulted()))
     return fail("--no-web turns the web viewer off: drop --web-port and --web-root, or --no-web");
+  // The build's own folder may be unbuilt (the server then says how to build it); a folder given must exist.
+  if (std::error_code ec; !vm["web-root"].defaulted() && !std::filesystem::is_directory(o.web_root, ec))
+    return fail("--web-root " + o.web_root +
+                (std::filesystem::exists(o.web_root, ec) ? " is not a folder" : " does not exist") +
+                ": give the folder that holds the page's index.html");
   if (!no_web && port != 0 && port == web_port)
     return fail("--port and --web-port are both " + std::to_string(port) + "; give them different ports");
   if (!std::isfinite(o.snapshot_rate) || o.snapshot_rate < 1.0 || o.snapshot_rate > 1000.0)

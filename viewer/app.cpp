@@ -138,7 +138,10 @@ int run_viewer(const ViewerOptions& opt) {
   glfwSetErrorCallback(on_glfw_error);
   GlfwSession glfw;
   if (!glfw.ok) {
-    std::fprintf(stderr, "fishtank-viewer: cannot open the display (is DISPLAY set?)\n");
+    std::fprintf(
+        stderr,
+        "fishtank-viewer: cannot open the display (is DISPLAY set?); without one, run it under xvfb-run, "
+        "or open the server's browser viewer (the 'web viewer on' line of its log)\n");
     return 1;
   }
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);

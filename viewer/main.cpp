@@ -62,9 +62,13 @@ int main(int argc, char** argv) {
   if (opt.frames < 1) return refuse("--frames must be at least 1, got " + std::to_string(opt.frames));
   if (vm.count("frames") && opt.screenshot.empty())
     return refuse("--frames counts the frames before --screenshot: give --screenshot FILE too, or drop it");
-  if (!opt.screenshot.empty())
-    if (const std::string why = fishtank::check_writable_file(opt.screenshot); !why.empty())
-      return refuse("--screenshot " + opt.screenshot + ": " + why);
+  if (!opt.screenshot.empty()) {
+    const std::string& path = opt.screenshot;
+    if (path.size() < 4 || path.compare(path.size() - 4, 4, ".png") != 0)
+      return refuse("--screenshot writes a PNG: name a .png file, got '" + path + "'");
+    if (const std::string why = fishtank::check_writable_file(path); !why.empty())
+      return refuse("--screenshot " + path + ": " + why);
+  }
   if (vm.count("max-fps") && (opt.max_fps < 0 || opt.max_fps > fishtank::viewer::FramePacer::kMaxFps))
     return refuse("--max-fps must be between 0 (no cap) and " +
                   std::to_string(fishtank::viewer::FramePacer::kMaxFps) + ", got " +

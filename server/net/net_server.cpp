@@ -32,6 +32,9 @@ std::string NetServer::bind(Listener& listener, const std::string& address, std:
   if (ec == asio::error::address_in_use)
     return "cannot listen on " + address + ":" + std::to_string(port) +
            ": another program (another fishtank-server?) holds that port; " + in_use_hint;
+  if (ec == boost::system::errc::address_not_available)
+    return "cannot listen on " + address + ":" + std::to_string(port) +
+           ": that is not an address of this machine; --bind 0.0.0.0 listens on all of them";
   if (ec) return "cannot listen on " + address + ":" + std::to_string(port) + ": " + ec.message();
   return {};
 }

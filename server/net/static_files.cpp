@@ -74,9 +74,9 @@ std::string StaticFiles::not_found_page() const {
   if (page_built_) return head + "<h1>404: not found</h1>\n<p>No such file in the viewer's page.</p>\n</body></html>\n";
   return head +
          "<h1>404: the browser viewer is not built</h1>\n"
-         "<p>This fishtank-server serves the page from <code>" +
-         root_text_ +
-         "</code>, which holds no <code>index.html</code>.</p>\n"
+         // The folder is named in the server's log, not to every browser that asks.
+         "<p>The folder this fishtank-server serves the page from (its log names it) holds no "
+         "<code>index.html</code>.</p>\n"
          "<p>Build the page with <code>cmake --build build</code> on a machine with Node and npm (the README "
          "says how), or start the server with <code>--web-root DIR</code> naming a built page. "
          "WebSocket clients can connect to <code>/ws</code> all the same.</p>\n</body></html>\n";

@@ -192,9 +192,10 @@ def test_other_methods_get_405_upgrades_elsewhere_404_and_an_over_size_header_43
 
 
 def test_without_a_built_page_the_server_says_how_to_build_it_and_ws_still_works(start_server, tmp_path):
-    server = start_server("--balls", "10", "--web-port", "0", "--web-root", str(tmp_path / "missing"))
+    server = start_server("--balls", "10", "--web-port", "0", "--web-root", str(tmp_path))  # no index.html in it
     status, _, body = _request(server.web_port, "GET", "/")
     assert status == 404 and b"not built" in body and b"--web-root" in body
+    assert str(tmp_path).encode() not in body  # the server's folders are not shown to whoever asks
     assert "not built" in server.text()
 
     async def welcomed():

@@ -114,6 +114,15 @@ def test_output_paths_that_cannot_be_written_are_refused_before_anything_runs(tm
     assert (made / "data.fishtank").exists() and (made / "in.fishtank").exists()
 
 
+def test_an_address_not_of_this_machine_is_refused_saying_so_and_what_listens_everywhere():
+    # 192.0.2.1 is TEST-NET-1 (RFC 5737): never an address of this machine.
+    run = subprocess.run([SERVER, "--bind", "192.0.2.1", "--port", "0", "--no-web", "--duration", "5"],
+                         capture_output=True, text=True, timeout=30)
+    assert run.returncode != 0
+    assert ("cannot listen on 192.0.2.1:0: that is not an address of this machine; --bind 0.0.0.0 listens on all "
+            "of them") in run.stderr, run.stderr
+
+
 def test_a_client_with_no_server_says_where_why_and_the_command_that_starts_one_there():
     with socket.socket() as probe:  # a port just freed: nothing listens there
         probe.bind(("127.0.0.1", 0))

@@ -23,6 +23,7 @@ VIEWER = os.path.join(os.environ["FISHTANK_BUILD_DIR"], "viewer", "fishtank-view
     (["--duration", "-2"], "--duration must be a number of seconds >= 0 (0: stay open), got -2"),
     (["--duration", "soon"], "the argument ('soon') for option '--duration' is invalid"),
     # Checked before a window opens, not found when the frames are drawn.
+    (["--screenshot", "shot.jpg"], "--screenshot writes a PNG: name a .png file, got 'shot.jpg'"),
     (["--screenshot", "/nonexistent-folder/shot.png"],
      "--screenshot /nonexistent-folder/shot.png: the folder /nonexistent-folder does not exist"),
 ])
