@@ -13,6 +13,8 @@ against simulated time since the restart.
 """
 
 import argparse
+import math
+import os
 import sys
 import time
 
@@ -42,15 +44,57 @@ def pile_height(tank, radii):
     return float(np.percentile(tops[resting], 99)) if resting.any() else 0.0, len(b.ids), b.sim_time
 
 
+def whole_number(lowest, highest):
+    def parse(text):
+        try:
+            value = int(text)
+        except ValueError:
+            value = None
+        if value is None or not lowest <= value <= highest:
+            raise argparse.ArgumentTypeError(f"a whole number from {lowest} to {highest}, got {text!r}")
+        return value
+    return parse
+
+
+def positive_seconds(text):
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"a positive number of seconds, got {text!r}")
+    return value
+
+
+def check_out(parser, out):
+    """Refuses a plot that could not be written, before the measuring time rather than after it."""
+    folder = os.path.dirname(os.path.abspath(out))
+    if os.path.isdir(out):
+        example = os.path.join(out, "pile_height.png")
+        parser.error(f"argument --out: {out} is a folder; give a file in it, e.g. {example}")
+    if not os.path.isdir(folder):
+        parser.error(f"argument --out: the folder {folder} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        parser.error(f"argument --out: the folder {folder} is not writable")
+    suffix = os.path.splitext(out)[1].lstrip(".").lower()
+    formats = plt.figure().canvas.get_supported_filetypes()
+    plt.close("all")
+    if suffix and suffix not in formats:
+        parser.error(f"argument --out: matplotlib cannot write .{suffix} files; use one of "
+                     + ", ".join(f".{f}" for f in sorted(formats)))
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--host", default="127.0.0.1")
-    parser.add_argument("--port", type=int, default=7878)
-    parser.add_argument("--seconds", type=float, default=20.0, help="wall seconds to measure for")
-    parser.add_argument("--seed", type=int, default=1, help="seed of the tank scene's restart")
-    parser.add_argument("--add", type=int, default=0, help="balls to pour in besides the scene's own")
+    parser.add_argument("--port", type=whole_number(1, 65535), default=7878)
+    parser.add_argument("--seconds", type=positive_seconds, default=20.0, help="wall seconds to measure for")
+    parser.add_argument("--seed", type=whole_number(0, 2**64 - 1), default=1, help="seed of the tank scene's restart")
+    parser.add_argument("--add", type=whole_number(0, 2**32 - 1), default=0,
+                        help="balls to pour in besides the scene's own")
     parser.add_argument("--out", default="pile_height.png", help="the plot (PNG)")
     args = parser.parse_args()
+    check_out(parser, args.out)
 
     with Client(args.host, args.port) as tank:
         radii = np.array([diameter / 2 for diameter, _ in tank.kinds], dtype=np.float32)
@@ -59,7 +103,7 @@ def main():
             tank.add_balls(args.add)
         times, heights, counts = [], [], []
         end = time.monotonic() + args.seconds
-        while time.monotonic() < end:
+        while not times or time.monotonic() < end:  # one measurement at least, for the plot and the summary
             height, balls, sim_time = pile_height(tank, radii)
             times.append(sim_time - start.sim_time)
             heights.append(height)

@@ -13,6 +13,7 @@ may take as long as it likes between calls: snapshot() returns the newest.
 
 import math
 import numbers
+import re
 import socket
 import struct
 import threading
@@ -31,6 +32,11 @@ _IDENTIFIER = b"FTNK"
 _MAX_FRAME_BYTES = 64 << 20  # the server's cap (kMaxServerFrameBytes)
 _QUANT_STEPS = np.float32(65535.0)  # protocol/quantize.h: kQuantSteps
 _ERROR_NAMES = {value: name for name, value in vars(ErrorCode.ErrorCode).items() if not name.startswith("_")}
+_UINT32_MAX = 2**32 - 1  # AddBalls.count, Step.count
+_UINT64_MAX = 2**64 - 1  # Reset.seed
+_SCENES = "tank, wide, dam-break or drop"
+# "host:port" or "[v6]:port" in one string; an unbracketed IPv6 literal ("::1") has more than one colon.
+_HOST_WITH_PORT = re.compile(r"\[([^\]]+)\]:(\d+)|([^:\[\]]+):(\d+)")
 
 
 class FishtankError(RuntimeError):
@@ -71,11 +77,11 @@ class Snapshot:
     tank_max: np.ndarray
 
 
-def _whole_number(value, what, lowest):
-    """value as an int, or ValueError naming what: the wire's unsigned fields would refuse it less clearly,
-    and a fraction would be cut silently."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < lowest:
-        raise ValueError(f"{what} must be a whole number of at least {lowest}, got {value!r}")
+def _whole_number(value, what, lowest, highest):
+    """value as an int, or ValueError naming what and its range: the wire's unsigned fields would refuse it
+    less clearly (FlatBuffers' TypeError), and a fraction would be cut silently."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not lowest <= value <= highest:
+        raise ValueError(f"{what} must be a whole number from {lowest} to {highest}, got {value!r}")
     return int(value)
 
 
@@ -127,15 +133,19 @@ class Client:
 
     def __init__(self, host="127.0.0.1", port=7878, player=True, name="fishtank-python", timeout=10.0):
         # Checked here: the socket layer would wrap 70000 to another port, or fail in its own words.
-        port = _whole_number(port, "port", 1)
-        if port > 65535:
-            raise ValueError(f"port must be at most 65535, got {port}")
+        port = _whole_number(port, "port", 1, 65535)
         if not (isinstance(timeout, (int, float)) and timeout > 0):
             raise ValueError(f"timeout must be a positive number of seconds, got {timeout!r}")
         self.timeout = timeout
         # "[::1]" as the server's listening line and --connect write an IPv6 address; the socket wants "::1".
         if isinstance(host, str) and len(host) > 2 and host[0] == "[" and host[-1] == "]":
             host = host[1:-1]
+        # Refused before any look-up, which would only say the name does not resolve.
+        if isinstance(host, str) and (joined := _HOST_WITH_PORT.fullmatch(host)):
+            alone, digits = (joined[1], joined[2]) if joined[1] else (joined[3], joined[4])
+            raise FishtankError("cannot_connect", f"{host} is a host and a port in one string; give the port as "
+                                f'the second argument: Client("{alone}", {int(digits)})')
+        self._wants_player = bool(player)
         self.address = f"[{host}]:{port}" if ":" in str(host) else f"{host}:{port}"
         self._sock = self._connect(host, port)
         self._sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
@@ -184,8 +194,7 @@ class Client:
         def holds():
             # The refusal and the place in line come before any snapshot, so a snapshot without them means no line.
             if self.player_id is None and self.ahead_in_line is None and self._last is not None:
-                raise FishtankError("no_player", "this client is not in line for a player sphere" +
-                                    self._last_error_text())
+                raise FishtankError("no_player", self._not_in_line_text())
             return self.player_id is not None
 
         self._wait(holds, time.monotonic() + (self.timeout if timeout is None else timeout))
@@ -193,6 +202,7 @@ class Client:
 
     def move(self, velocity):
         """Sets the player sphere's velocity (metres per second, x y z); it keeps it until the next move()."""
+        self._check_open()  # before the sphere: a closed client says it is closed
         if self.player_id is None:  # the reader takes a sphere freed by another (PlayerGranted) as it comes
             raise FishtankError("no_player", "this client has no player sphere to move")
         # Checked here, not refused by the server later: move() does not wait, so a refusal would be raised
@@ -216,7 +226,7 @@ class Client:
 
     def add_balls(self, n):
         """Asks the server to pour n more balls in from the top; raises FishtankError if it took fewer."""
-        n = _whole_number(n, "add_balls' n", 1)
+        n = _whole_number(n, "add_balls' n", 1, _UINT32_MAX)
         self._send(_frame(Payload.Payload.AddBalls, lambda b: self._table(b, AddBalls, AddCount=n)))
         self._round_trip()
 
@@ -231,7 +241,7 @@ class Client:
 
     def step(self, n=1):
         """Runs n steps while paused and returns the snapshot taken once they are done."""
-        n = _whole_number(n, "step's n", 1)
+        n = _whole_number(n, "step's n", 1, _UINT32_MAX)
         before = self._current().physics_steps
         self._send(_frame(Payload.Payload.Step, lambda b: self._table(b, Step, AddCount=n)))
         return self._wait_for(lambda s: (s.physics_steps - before) % 2**32 >= n)
@@ -242,6 +252,10 @@ class Client:
 
     def scene(self, name, seed=None):
         """Switches everyone to the named scene (tank, wide, dam-break, drop) and returns its first snapshot."""
+        # None would send no name, which the server takes as the running scene: that is reset()'s job.
+        if not isinstance(name, str):
+            raise ValueError(f"scene's name must be a string ({_SCENES}), got {name!r}; reset() starts the "
+                             "running scene again")
         return self._restart(name, seed)
 
     def time_scale(self, scale):
@@ -304,7 +318,7 @@ class Client:
         return module.End(b)
 
     def _restart(self, name, seed):
-        seed = None if seed is None else _whole_number(seed, "seed", 0)
+        seed = None if seed is None else _whole_number(seed, "seed", 0, _UINT64_MAX)
         before = self._current().scene_start
 
         def build(b):
@@ -322,6 +336,7 @@ class Client:
     def _send(self, frame):
         """Sends for the caller: a connection that has ended raises why it ended (the server's last Error), not
         a bare broken pipe, and not only from the second send after it."""
+        self._check_open()  # the socket is gone: a send would fail with a bad file descriptor
         with self._changed:
             if self._ended is not None:
                 raise self._ended
@@ -346,6 +361,7 @@ class Client:
         connection ended, or FishtankError "timeout" at the deadline."""
         with self._changed:
             while True:
+                self._check_open()  # what arrived before close() is not an answer to a later call
                 value = ready()
                 if value:
                     return value
@@ -446,6 +462,17 @@ class Client:
 
     def _last_error_text(self):
         return f" ({self.errors[-1]})" if self.errors else ""
+
+    def _check_open(self):
+        if self._closing:
+            raise ConnectionError("this client was closed")
+
+    def _not_in_line_text(self):
+        """Why this client has no sphere and waits for none: only the refusals about spheres say why."""
+        if not self._wants_player:
+            return "this client is not in line for a player sphere: it asked for none (Client(..., player=False))"
+        reason = next((e for e in reversed(self.errors) if e.code in ("player_limit", "player_idle")), None)
+        return "this client is not in line for a player sphere" + (f" ({reason})" if reason else "")
 
     @staticmethod
     def _split_frame(buffer):

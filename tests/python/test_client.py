@@ -215,9 +215,9 @@ def test_the_server_command_binds_where_the_default_127_0_0_1_would_not_answer()
 
 def test_a_port_or_timeout_out_of_range_is_refused_before_any_connection_with_the_range():
     for port in (0, "7878", 7878.0, True):
-        with pytest.raises(ValueError, match=r"port must be a whole number of at least 1"):
+        with pytest.raises(ValueError, match=r"port must be a whole number from 1 to 65535, got"):
             Client("127.0.0.1", port)
-    with pytest.raises(ValueError, match=r"port must be at most 65535, got 70000"):
+    with pytest.raises(ValueError, match=r"port must be a whole number from 1 to 65535, got 70000"):
         Client("127.0.0.1", np.int64(70000))
     for timeout in (0, -1):
         with pytest.raises(ValueError, match=r"timeout must be a positive number of seconds"):
@@ -233,13 +233,89 @@ def test_arguments_the_wire_cannot_carry_raise_value_error_at_once_and_the_next_
                 tank.move(bad)
         for call, bad in ((tank.add_balls, -5), (tank.add_balls, 0), (tank.add_balls, 1.5), (tank.step, 0), (tank.step, -1),
                           (tank.reset, -1), (lambda seed: tank.scene("drop", seed=seed), 2.5)):
-            with pytest.raises(ValueError, match="must be a whole number of at least"):
+            with pytest.raises(ValueError, match="must be a whole number from"):
                 call(bad)
+        # Beyond the wire's uint32 counts and uint64 seed: FlatBuffers' TypeError otherwise.
+        counts, seeds = "from 1 to 4294967295", "from 0 to 18446744073709551615"
+        reset, scene = (lambda seed: tank.reset(seed=seed)), (lambda seed: tank.scene("drop", seed=seed))
+        for call, bad, what, allowed in ((tank.add_balls, 2**32, "add_balls' n", counts),
+                                         (tank.add_balls, 2**40, "add_balls' n", counts),
+                                         (tank.step, 2**40, "step's n", counts),
+                                         (reset, 2**64, "seed", seeds), (reset, 2**70, "seed", seeds),
+                                         (scene, 2**64, "seed", seeds)):
+            with pytest.raises(ValueError) as refused:
+                call(bad)
+            assert str(refused.value) == f"{what} must be a whole number {allowed}, got {bad}"
         # Nothing of the above reached the server: the refusal a time scale of 5 raises is its own.
         with pytest.raises(FishtankError) as refused:
             tank.time_scale(5)
         assert refused.value.code == "invalid_value" and "SetTimeScale" in refused.value.message
         assert tank.errors == [refused.value]
+
+
+def test_a_scene_name_that_is_not_a_string_raises_value_error_naming_the_scenes_and_none_does_not_reset(start_server):
+    server = start_server("--balls", "10")
+    with Client("127.0.0.1", server.port) as tank:
+        before = tank.snapshot().scene_start
+        for bad in (5, None, b"drop"):
+            with pytest.raises(ValueError) as refused:
+                tank.scene(bad)
+            assert str(refused.value) == ("scene's name must be a string (tank, wide, dam-break or drop), "
+                                          f"got {bad!r}; reset() starts the running scene again")
+        assert tank.pause().scene_start == before and tank.errors == []  # nothing reached the server
+
+
+def test_every_call_after_close_raises_connection_error_this_client_was_closed(start_server):
+    server = start_server("--balls", "10")
+    player, observer = Client("127.0.0.1", server.port), Client("127.0.0.1", server.port, player=False)
+    for tank in (player, observer):
+        tank.snapshot()
+        time.sleep(0.3)  # newer snapshots arrive: one waits to be taken, as it would for a call after close()
+        tank.close()
+        for call in (tank.snapshot, tank.wait_for_player, lambda: tank.move((1, 0, 0)), lambda: tank.add_balls(1),
+                     tank.pause, tank.resume, tank.step, tank.reset, lambda: tank.scene("drop"),
+                     lambda: tank.time_scale(0.5)):
+            with pytest.raises(ConnectionError) as closed:
+                call()
+            assert str(closed.value) == "this client was closed"
+        tank.close()  # again: nothing to do
+
+
+def test_a_host_with_its_port_in_one_string_raises_cannot_connect_saying_to_give_the_port_second(monkeypatch):
+    tried = []
+
+    def unknown(address, timeout):  # what the resolver says of a name holding a port, without asking one
+        tried.append(address)
+        raise socket.gaierror(socket.EAI_NONAME, "Name or service not known")
+
+    monkeypatch.setattr(socket, "create_connection", unknown)
+    for host, alone, port in (("127.0.0.1:47110", "127.0.0.1", 47110), ("tank.example:7878", "tank.example", 7878),
+                              ("[::1]:7878", "::1", 7878)):
+        with pytest.raises(FishtankError) as joined:
+            Client(host)
+        assert joined.value.code == "cannot_connect"
+        assert joined.value.message == (f"{host} is a host and a port in one string; give the port as the second "
+                                        f'argument: Client("{alone}", {port})')
+    assert tried == []  # refused before any look-up
+    for host in ("::1", "[::1]", "fe80::1"):  # IPv6 literals end in a colon and digits too
+        with pytest.raises(FishtankError, match="cannot resolve"):
+            Client(host, 7878)
+    assert [address[0] for address in tried] == ["::1", "::1", "fe80::1"]
+
+
+def test_waiting_for_a_sphere_says_why_with_the_refusal_about_spheres_not_an_unrelated_later_one(start_server):
+    server = start_server("--balls", "10", "--max-players", "0")
+    with Client("127.0.0.1", server.port) as refused, Client("127.0.0.1", server.port, player=False) as watcher:
+        for client, why in ((refused, " (player_limit: this server has no player spheres (--max-players 0); you are "
+                                      "observing)"),
+                            (watcher, ": it asked for none (Client(..., player=False))")):
+            with pytest.raises(FishtankError) as unrelated:
+                client.add_balls(1)  # observers may not add balls: the newest refusal
+            assert unrelated.value.code == "not_permitted"
+            with pytest.raises(FishtankError) as none:
+                client.wait_for_player(timeout=10)
+            assert none.value.code == "no_player"
+            assert none.value.message == "this client is not in line for a player sphere" + why
 
 
 def test_the_example_with_no_server_says_why_and_what_to_do_in_one_line_without_a_traceback():
@@ -253,6 +329,36 @@ def test_the_example_with_no_server_says_why_and_what_to_do_in_one_line_without_
     assert run.stderr.strip().splitlines() == [
         f"pile_height.py: cannot_connect: nothing listens at 127.0.0.1:{port} (connection refused); start a server "
         f"there with build/server/fishtank-server --port {port}, or use the port its 'listening on' line shows"]
+
+
+def _example(*args):
+    example = Path(__file__).resolve().parents[2] / "docs" / "examples" / "pile_height.py"
+    return subprocess.run([sys.executable, example, *args], capture_output=True, text=True, timeout=60,
+                          env={**os.environ, "MPLBACKEND": "Agg"})
+
+
+def test_the_example_refuses_arguments_it_cannot_use_with_exit_2_before_connecting(tmp_path):
+    with socket.socket() as probe:  # nothing listens there: an example that connected first would exit 1
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    missing = tmp_path / "missing"
+    for args, words in ((["--seconds", "-2"], "argument --seconds: a positive number of seconds, got '-2'"),
+                        (["--seconds", "nan"], "argument --seconds: a positive number of seconds, got 'nan'"),
+                        (["--add", "-1"], "argument --add: a whole number from 0 to 4294967295, got '-1'"),
+                        (["--out", str(missing / "x.png")], f"argument --out: the folder {missing} does not exist"),
+                        (["--out", str(tmp_path)], f"argument --out: {tmp_path} is a folder; give a file in it"),
+                        (["--out", str(tmp_path / "x.txt")], "argument --out: matplotlib cannot write .txt files")):
+        run = _example("--port", str(port), *args)
+        assert run.returncode == 2, (args, run.stderr)
+        assert run.stderr.splitlines()[-1].startswith(f"pile_height.py: error: {words}"), run.stderr
+    assert list(tmp_path.iterdir()) == [] and not missing.exists()
+
+
+def test_the_example_measures_once_at_least_however_short_its_time(start_server, tmp_path):
+    server = start_server("--balls", "10")
+    run = _example("--port", str(server.port), "--seconds", "1e-9", "--out", str(tmp_path / "pile.png"))
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.startswith("1 measurements;") and (tmp_path / "pile.png").exists()
 
 
 def test_a_host_name_that_does_not_resolve_raises_cannot_connect_saying_to_check_it(monkeypatch):
