@@ -42,10 +42,11 @@ int main(int argc, char** argv) {
                     << (r.rtt_ms ? fishtank::number_text(*r.rtt_ms) + " ms" : "(no Pong came back)") << "\n";
       });
   if (!s.connect_error.empty()) {
+    const std::string advice =
+        fishtank::connection_advice(o.script.host, std::to_string(o.script.port), s.connect_error);
     std::cerr << "fishtank-client: no connection to "
               << fishtank::host_port_text(o.script.host, std::to_string(o.script.port)) << ": " << s.connect_error
-              << ". " << fishtank::connection_advice(o.script.host, std::to_string(o.script.port), s.connect_error)
-              << "\n";
+              << "." << (advice.empty() ? "" : " " + advice) << "\n";
     return 1;
   }
   const double bytes_per_ball = per_ball(s.bytes_per_s, s.snapshot_rate_hz, s.balls);

@@ -20,6 +20,13 @@ inline std::string server_command_hint(const std::string& host, const std::strin
 }
 
 inline constexpr std::string_view kCannotResolve = "cannot resolve ";
+inline constexpr std::string_view kClosedByServer = "the server closed the connection";
+
+// A client's reason when the server closed the connection: with the last Error it sent ("code: message"), if any,
+// which says why (a wrong port, a limit). connection_advice recognises both forms.
+inline std::string closed_by_server_text(const std::string& last_error) {
+  return std::string(kClosedByServer) + (last_error.empty() ? "" : " (" + last_error + ")");
+}
 
 // A client's reason that the name lookup of host failed, why: the one form connection_advice recognises.
 inline std::string cannot_resolve_text(const std::string& host, const std::string& why) {
@@ -30,6 +37,8 @@ inline std::string cannot_resolve_text(const std::string& host, const std::strin
 // does not resolve (cannot_resolve_text); for any other failure, start a server there.
 inline std::string connection_advice(const std::string& host, const std::string& port, const std::string& error) {
   if (error.rfind(kCannotResolve, 0) == 0) return "Check the host name, or give its IP address.";
+  // A server answered and said why it closed: starting another there is not the remedy.
+  if (error.rfind(std::string(kClosedByServer) + " (", 0) == 0) return "";
   return server_command_hint(host, port);
 }
 

@@ -99,8 +99,8 @@ void report_connection(const ConnectionStatus& s, const std::string& advice, std
   }
   if (s.last_error.empty() || s.last_error == reported) return;
   reported = s.last_error;
-  std::fprintf(stderr, "fishtank-viewer: no connection to %s: %s; retrying every second. %s\n",
-               s.endpoint.c_str(), s.last_error.c_str(), advice.c_str());
+  std::fprintf(stderr, "fishtank-viewer: no connection to %s: %s; retrying every second.%s%s\n",
+               s.endpoint.c_str(), s.last_error.c_str(), advice.empty() ? "" : " ", advice.c_str());
 }
 
 // The exit summary: the rates of the frames that drew the scene, or, when none

@@ -65,6 +65,10 @@ class NetServer final : public SessionOwner {
   void session_welcomed(Session& session) override;
   void session_closed(Session& session) override;
   void bytes_sent(std::size_t bytes) override;
+  std::uint16_t listening_port(bool web) const override {
+    const boost::asio::ip::tcp::acceptor& acceptor = (web ? web_ : tcp_).acceptor;
+    return acceptor.is_open() ? acceptor.local_endpoint().port() : 0;
+  }
   void snapshot_skipped() override { snapshots_skipped_.fetch_add(1, std::memory_order_relaxed); }
   CodedSnapshot snapshot_frame(const SharedSnapshot& snapshot, std::optional<std::uint32_t> base,
                                std::optional<std::uint32_t> prior,

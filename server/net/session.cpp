@@ -63,6 +63,14 @@ void Session::carry_out(Outcome outcome) {
   do_write();
 }
 
+void Session::answer_in_kind_and_close(std::vector<std::uint8_t> bytes, const std::string& log) {
+  Outcome outcome;
+  outcome.replies.push_back(std::move(bytes));
+  outcome.disconnect = true;
+  outcome.log = log;
+  carry_out(std::move(outcome));
+}
+
 void Session::offer_snapshot(SharedSnapshot snapshot) {
   if (closed_ || close_after_write_ || !protocol_.welcomed() || !protocol_.watching()) return;
   if (newest_snapshot_) owner_.snapshot_skipped();

@@ -48,6 +48,8 @@ class SessionOwner {
   virtual void session_welcomed(Session& session) = 0;
   virtual void session_closed(Session& session) = 0;
   virtual void bytes_sent(std::size_t bytes) = 0;
+  // The port the server listens on for clients (web: the browser viewer's); 0 where it does not.
+  virtual std::uint16_t listening_port(bool web) const = 0;
   // A snapshot offered to a session was replaced by a newer one before it could go out: a slow link or reader.
   virtual void snapshot_skipped() = 0;
   // The frame of snapshot for a client that holds snapshots `base` (empty: none) and `prior`.
@@ -98,6 +100,9 @@ class Session : public std::enable_shared_from_this<Session> {
   // Sends what waits, e.g. once the transport carries frames.
   void do_write();
   bool ending() const { return close_after_write_; }
+  // A peer speaking another protocol on this port: these bytes, in its protocol, then the usual end.
+  void answer_in_kind_and_close(std::vector<std::uint8_t> bytes, const std::string& log);
+  SessionOwner& owner() const { return owner_; }
   bool closed() const { return closed_; }
   // A TCP frame's length prefix, checked against the cap that applies now.
   protocol::DecodeResult check_length_prefix(const std::uint8_t* prefix, std::uint32_t* body_bytes) const {

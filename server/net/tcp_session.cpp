@@ -7,6 +7,14 @@ namespace asio = boost::asio;
 namespace {
 // A frame's buffer starts at this and doubles as its bytes arrive.
 constexpr std::size_t kFirstChunkBytes = 4096;
+
+// The first four bytes of an HTTP request: a browser given this port instead of the web viewer's.
+bool starts_http_request(const std::array<std::uint8_t, protocol::kLengthPrefixBytes>& first) {
+  const std::string text(first.begin(), first.end());
+  for (const char* method : {"GET ", "HEAD", "POST", "PUT ", "OPTI", "DELE", "PATC", "CONN", "TRAC"})
+    if (text == method) return true;
+  return false;
+}
 }  // namespace
 
 TcpSession::TcpSession(asio::ip::tcp::socket socket, const asio::ip::tcp::endpoint& peer, std::uint32_t id,
@@ -22,6 +30,7 @@ void TcpSession::do_read() {
                      if (ec) return on_error(ec, "disconnected");
                      received_bytes();
                      if (ending()) return do_drain();
+                     if (!hello_received() && starts_http_request(header_)) return answer_browser();
                      std::uint32_t body_bytes = 0;
                      const protocol::DecodeResult length = check_length_prefix(header_.data(), &body_bytes);
                      if (!length.ok()) {
@@ -32,6 +41,21 @@ void TcpSession::do_read() {
                      incoming_.assign(header_.begin(), header_.end());
                      do_read_body();
                    });
+}
+
+void TcpSession::answer_browser() {
+  const std::uint16_t web = owner().listening_port(/*web=*/true);
+  const std::string body =
+      "This port speaks Fishtank's own protocol, for fishtank-viewer, fishtank-client and the Python client.\n" +
+      (web ? "The browser viewer is on port " + std::to_string(web) + " of this machine: put " + std::to_string(web) +
+                 " in the address instead.\n"
+           : std::string("This server serves no browser viewer (it was started with --no-web).\n"));
+  const std::string response =
+      "HTTP/1.1 400 Bad Request\r\nContent-Type: text/plain; charset=utf-8\r\n"
+      "Content-Length: " +
+      std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n" + body;
+  answer_in_kind_and_close(std::vector<std::uint8_t>(response.begin(), response.end()),
+                           "an HTTP request on the TCP port: told the browser the web viewer's port");
 }
 
 // The buffer doubles as the bytes come in, so a peer that announces a large

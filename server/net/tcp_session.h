@@ -27,6 +27,8 @@ class TcpSession final : public Session {
   const char* transport_label() const override { return ""; }
 
   void do_read_body();
+  // A browser given the TCP port: a plain HTTP answer naming the web viewer's port, then the end.
+  void answer_browser();
 
   boost::asio::ip::tcp::socket socket_;
   std::array<std::uint8_t, protocol::kLengthPrefixBytes> header_{};

@@ -36,10 +36,32 @@ void WebSession::do_read_request() {
                           "<p>413: the request's body is over " + std::to_string(kMaxRequestBodyBytes) +
                               " bytes; this server only serves files (GET, HEAD).</p>\n",
                           false);
+    if (ec && reads_as_fishtank_frame()) return answer_fishtank_client();
     if (ec) return on_error(ec, "disconnected");
     received_bytes();
     on_request();
   });
+}
+
+bool WebSession::reads_as_fishtank_frame() const {
+  // A size-prefixed FlatBuffer: the length, the root's offset, then the file identifier.
+  const auto* bytes = static_cast<const std::uint8_t*>(buffer_.data().data());
+  const std::size_t at = protocol::kLengthPrefixBytes + 4, size = buffer_.size();
+  return size >= at + 4 && std::equal(bytes + at, bytes + at + 4, protocol::kFileIdentifier);
+}
+
+void WebSession::answer_fishtank_client() {
+  const std::uint16_t tcp = owner().listening_port(/*web=*/false);
+  auto error = std::make_shared<protocol::Frame>(
+      protocol::encode_error(wire::ErrorCode::wrong_port,
+                             "this is fishtank-server's web port, for browsers; fishtank-viewer, "
+                             "fishtank-client and the Python client connect to its port " +
+                                 std::to_string(tcp) + " (the 'listening on' line of its log)"));
+  // Written as is, not through the Session: a connection before the upgrade carries no frames.
+  asio::async_write(http_.socket(), asio::buffer(*error),
+                    [this, self = shared_from_this(), error](beast::error_code, std::size_t) {
+                      close("a Fishtank client on the web port: told it the TCP port");
+                    });
 }
 
 void WebSession::on_request() {

@@ -41,6 +41,9 @@ class WebSession final : public Session {
   void do_read_request();
   void on_request();
   void upgrade();
+  // A fishtank-viewer or client given the web port: an Error frame naming the TCP port, then the end.
+  bool reads_as_fishtank_frame() const;
+  void answer_fishtank_client();
   void respond_text(boost::beast::http::status status, const std::string& body, bool keep_alive,
                     const char* type = "text/html; charset=utf-8");
   template <class Body>

@@ -213,3 +213,22 @@ def test_a_web_port_in_use_is_refused_with_a_message_naming_both_flags(start_ser
     assert second.returncode == 1
     assert f"127.0.0.1:{first.web_port}" in second.stderr
     assert "--web-port" in second.stderr and "--no-web" in second.stderr
+
+
+def test_each_port_given_to_the_other_kind_of_client_answers_in_its_kind_with_the_right_port(start_server):
+    """A browser pointed at the TCP port, or fishtank-viewer at the web port, learns which port it wanted."""
+    from fishtank import Client, FishtankError
+
+    server = start_server("--balls", "10", "--web-port", "0")
+    status, _, body = _request(server.port, "GET", "/")
+    assert status == 400
+    assert f"The browser viewer is on port {server.web_port} of this machine".encode() in body
+    with pytest.raises(FishtankError) as wrong:
+        Client("127.0.0.1", server.web_port)
+    assert wrong.value.code == "wrong_port" and f"connect to its port {server.port} " in wrong.value.message
+    cli = subprocess.run([os.path.join(os.path.dirname(os.environ["FISHTANK_SERVER"]), "..", "client",
+                                       "fishtank-client"), "--connect", f"127.0.0.1:{server.web_port}",
+                          "--duration", "1"], capture_output=True, text=True, timeout=30)
+    assert cli.returncode == 1
+    assert f"the server closed the connection (wrong_port: " in cli.stderr and f"port {server.port} " in cli.stderr
+    assert "To start a server here" not in cli.stderr  # one is there
