@@ -8,7 +8,7 @@ rewrites, which keep it a few seconds long and off other people's ports:
 - build/, scripts/ and docs/ are this checkout's (FISHTANK_BUILD_DIR for build/);
   a program quoted by name alone is build/'s;
 - servers run on --port 0 (and --no-web unless a web port is given) for --duration 1 at most (a trailing
-  & is dropped);
+  & is dropped); a recording starts at once (--record-from 0), of 60 balls where it waits for the pour;
 - clients, viewers and Python examples go to a fresh server of 300 balls on one
   thread, for 1 s at most; a viewer runs under xvfb-run; otherhost is 127.0.0.1;
 - benchmarks time small scenes: --balls 60 (10 000, the least, for wide), --steps 200 at most;
@@ -120,6 +120,10 @@ def rewrite_program(words, port):
                 words.append("--no-web")  # the default web port 8080 may be taken (a server the reader runs)
             set_flag(words, "--threads", "1")
             limit_duration(words)
+            if "--record-from" in words:  # the second it names lies past the second the server runs
+                set_flag(words, "--record-from", "0")
+                if "--record-constant-count" in words:
+                    set_flag(words, "--balls", "60")  # poured in well within that second
     elif name in ("fishtank-client", "fishtank-viewer"):
         if "--connect" not in words:
             words += ["--connect", f"127.0.0.1:{port}"]

@@ -48,8 +48,9 @@ struct Link {
 
 }  // namespace
 
-TEST_CASE("of resets queued at one step boundary only the last is carried out; another client's earlier one is told",
-          "[net][sandbox]") {
+TEST_CASE(
+    "of resets queued at one step boundary only the last is carried out, and another client's earlier one is told",
+    "[net][sandbox]") {
   Link l;
   const std::uint32_t starts = l.scene.start_count();
   l.reset(1, "drop");
