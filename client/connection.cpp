@@ -155,7 +155,6 @@ void Connection::on_snapshot(const wire::Snapshot& s) {
     return;
   }
   if (acknowledge_) send(protocol::encode_ack(s.tick()));
-  if (stats_.snapshots > 0 && s.tick() > view_.tick + 1) stats_.skipped_snapshots += s.tick() - view_.tick - 1;
   if (s.ball_count() > view_.kinds.size())
     stats_.errors.push_back("Snapshot has " + std::to_string(s.ball_count()) + " balls but kinds of only " +
                             std::to_string(view_.kinds.size()) + " were sent");
@@ -173,8 +172,6 @@ void Connection::on_snapshot(const wire::Snapshot& s) {
   view_.scene = s.scene() ? server_text(s.scene()->str()) : std::string();
   if (s.scene_start() != view_.scene_start) view_.positions.clear();  // other balls: nothing to compare
   view_.scene_start = s.scene_start();
-  view_.kinetic_energy_per_ball = s.kinetic_energy_per_ball();
-  view_.contacts = s.contacts();
   view_.max_overlap = s.max_overlap();
   if (s.tank_min()) {  // decode_frame checked that both are present and ordered
     tank_.min = {s.tank_min()->x(), s.tank_min()->y(), s.tank_min()->z()};

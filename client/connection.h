@@ -22,7 +22,6 @@ namespace fishtank::client {
 struct ConnectionStats {
   std::uint64_t snapshots = 0;
   std::uint64_t bytes_received = 0;
-  std::uint64_t skipped_snapshots = 0;   // gaps in Snapshot.tick
   std::uint64_t keyframes = 0;           // snapshots sent in full; the others were deltas
   std::vector<double> rtt_ms;            // one per Pong
   std::vector<std::string> errors;       // Error messages, "code: message"
@@ -50,9 +49,7 @@ struct WorldView {
   float time_scale_set = 0.0f;  // asked for; 0: the server did not say
   std::string scene;
   std::uint32_t scene_start = 0;  // +1 per scene (re)start: ball ids restart
-  float kinetic_energy_per_ball = 0.0f;
-  std::uint32_t contacts = 0;
-  float max_overlap = 0.0f;  // Snapshot.max_overlap
+  float max_overlap = 0.0f;       // Snapshot.max_overlap
   std::uint32_t ball_count = 0;
   std::vector<std::uint16_t> positions;  // quantised, 3 per ball (protocol/quantize.h)
   std::vector<std::uint8_t> kinds;       // by ball id, from BallKinds

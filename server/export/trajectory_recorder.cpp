@@ -19,7 +19,7 @@ std::string TrajectoryRecorder::finish(const World& world) {
   if (options_.path.empty()) return "";
   const std::string note = last_step_ == world.steps() ? "" : write(world);
   if (failed_) return note;
-  if (frames() > 0) return closed(note);
+  if (frames() > 0) return close_with(note);
   // An empty file is not what was asked for: say why, and fail like a write error.
   failed_ = true;
   char why[160];
@@ -27,11 +27,11 @@ std::string TrajectoryRecorder::finish(const World& world) {
                 world.ball_count());
   const std::string reason =
       world.ball_count() == 0 ? "" : ", before --record-from " + number_text(options_.from) + " s";
-  const std::string error = closed("");
+  const std::string error = close_with("");
   return error.empty() ? why + reason + "; " + options_.path + " is empty" : error;
 }
 
-std::string TrajectoryRecorder::closed(const std::string& note) {
+std::string TrajectoryRecorder::close_with(const std::string& note) {
   const std::string error = writer_.close();
   if (error.empty()) return note;
   failed_ = true;
@@ -44,7 +44,7 @@ std::string TrajectoryRecorder::write(const World& world) {
     if (frames() == 0 && world.pending() > 0) return "";  // balls are still pouring in
     if (frames() > 0 && world.ball_count() != count_) {
       ended_ = true;
-      if (const std::string error = closed(""); !error.empty()) return error;
+      if (const std::string error = close_with(""); !error.empty()) return error;
       char why[256];
       std::snprintf(why, sizeof why,
                     "recording ended at t = %.3f s: the ball count changed from %u to %u, and "

@@ -41,7 +41,7 @@ class TrajectoryRecorder {
  private:
   std::string write(const World& world);
   // Closes the file: note, or the write error its close found (the recording then failed).
-  std::string closed(const std::string& note);
+  std::string close_with(const std::string& note);
 
   RecordOptions options_;
   LammpsDumpWriter writer_;

@@ -54,7 +54,7 @@ std::vector<ip::address> machine_addresses(bool with_v6) {
   }
   freeifaddrs(list);
   v4 = put_first(std::move(v4), default_route_address(false));
-  v6 = put_first(std::move(v6), default_route_address(true));
+  if (with_v6) v6 = put_first(std::move(v6), default_route_address(true));
   v4.insert(v4.end(), v6.begin(), v6.end());
   return v4;
 }

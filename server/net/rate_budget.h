@@ -13,7 +13,7 @@ class RateBudget {
 
   RateBudget(double per_second, double burst) : per_second_(per_second), burst_(burst), available_(burst) {}
 
-  // Whole units available at `now`.
+  // Units available at `now` (a fraction while one refills).
   double available(Clock::time_point now) {
     refill(now);
     return available_;
