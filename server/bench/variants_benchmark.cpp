@@ -81,10 +81,7 @@ void time_steps(benchmark::State& state, World& world) {
 // Steps per repetition of step_tank, the same for every variant. Timed for a
 // minimum time instead, the faster variants stepped further from the settled
 // state, into stretches where the creeping pile needs its lists rebuilt more
-// often (1.0 rebuilds per 1000 steps for SSE on two threads against 0.39 for
-// the scalar twin), so the ratio between them measured the pile as well as
-// the code. 4000 steps are 2.8 simulated seconds, about 1.1 s of the scalar
-// twin's time.
+// often, so the ratio between them measured the pile as well as the code.
 constexpr benchmark::IterationCount kTankSteps = 4000;
 
 void step_tank(benchmark::State& state, const fishtank::Kernels& kernels) {

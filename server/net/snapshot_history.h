@@ -11,8 +11,8 @@
 // clients acknowledge the previous snapshot and one delta serves them all. A
 // client that still keeps the base and prior of a frame already coded, at most
 // kShareLag older than its own base, gets that frame too: paced clients
-// acknowledge different snapshots, and a frame of 100 000 balls takes
-// milliseconds to code. The per-client part is a lookup in a cache of a few entries.
+// acknowledge different snapshots, and a large scene's frame is costly to code. The per-client part is a lookup in a
+// cache of a few entries.
 
 #include <atomic>
 #include <cstddef>

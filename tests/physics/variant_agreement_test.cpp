@@ -60,7 +60,7 @@ TEST_CASE("scalar and SSE trajectories agree over a short horizon", "[physics][v
 
 TEST_CASE("scalar and SSE settle into the same pile", "[physics][variants][slow]") {
   // A pour is chaotic: one variant's piles from different seeds differ in mean
-  // height by up to ~4 %, so the statistics are averaged over kPours pours each.
+  // height, so the statistics are averaged over kPours pours each.
   struct Pile {
     double mean_height = 0.0, top = 0.0, overlap = 0.0;
   };
