@@ -56,8 +56,8 @@ std::string write_input(const World& world, const std::string& path, std::uint64
                "# Fishtank scene for LAMMPS (GRANULAR package), exported by fishtank-server.\n"
                "# k = %g N/m, e = %g, dt = %.9g s, %u balls.\n"
                "# Run on one core:   lmp -in in.fishtank\n"
-               "# Run on every core: mpirun --allow-run-as-root --use-hwthread-cpus -np $(nproc) lmp -in in.fishtank\n"
-               "#   (--allow-run-as-root: OpenMPI refuses root without it; --use-hwthread-cpus: one rank per CPU)\n"
+               "# Run on every core: mpirun --use-hwthread-cpus -np $(nproc) lmp -in in.fishtank\n"
+               "#   (--use-hwthread-cpus: one rank per CPU; as root, Open MPI also asks for --allow-run-as-root)\n"
                "# Contact: F = k x - c v_n, c = 2 zeta sqrt(k m_eff), zeta = -ln e / sqrt(pi^2 + ln^2 e),\n"
                "# no friction, no clamp at zero force (as in fishtank-server).\n\n",
                p.stiffness, p.restitution, world.dt(), world.ball_count());
