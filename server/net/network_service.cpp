@@ -36,18 +36,24 @@ NetworkService::NetworkService(const NetOptions& options, ServerInfo info, RunCo
           commands_, server_.viewers(), options.link, control, scene,
           [this](Reply reply) { server_.post_reply(std::move(reply)); },
           [this](SharedSnapshot snapshot) { server_.post_snapshot(std::move(snapshot)); }) {
-  signals_.async_wait([this, &stop](boost::system::error_code ec, int) {
+  signals_.async_wait([this, &stop](boost::system::error_code ec, int first) {
     if (ec) return;
     stop = true;
-    // The set keeps the signals until the server ends, so a second one must be heard here: while
-    // the final files are written (a blocked or huge --dump), it ends the process at once.
-    signals_.async_wait([](boost::system::error_code again, int signal) {
-      if (again) return;
-      std::fprintf(stderr,
-                   "fishtank-server: %s again: stopping at once; output files not finished are left as they are\n",
-                   signal == SIGINT ? "interrupted" : "terminated");
-      std::_Exit(128 + signal);
-    });
+    await_second_signal(first);
+  });
+}
+
+// The set keeps the signals until the server ends, so a second one must be heard here: while the final
+// files are written (a huge --dump), the same signal again ends the process at once. Another one passes:
+// a script's SIGTERM after the terminal's SIGINT (scripts/run's exit trap) must let the files be written.
+void NetworkService::await_second_signal(int first) {
+  signals_.async_wait([this, first](boost::system::error_code ec, int signal) {
+    if (ec) return;
+    if (signal != first) return await_second_signal(first);
+    std::fprintf(stderr,
+                 "fishtank-server: %s again: stopping at once; output files not finished are left as they are\n",
+                 signal == SIGINT ? "interrupted" : "terminated");
+    std::_Exit(128 + signal);
   });
 }
 

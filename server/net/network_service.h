@@ -51,6 +51,8 @@ class NetworkService {
   std::string status();
 
  private:
+  void await_second_signal(int first);
+
   NetOptions options_;
   boost::asio::io_context io_;
   boost::asio::executor_work_guard<boost::asio::io_context::executor_type> work_;

@@ -241,3 +241,25 @@ def test_a_second_ctrl_c_ends_a_server_that_is_writing_its_final_files(tmp_path)
     finally:
         server.kill()
         server.wait()
+
+
+def test_a_sigterm_after_ctrl_c_lets_the_server_write_its_final_files(tmp_path):
+    # scripts/run's exit trap sends SIGTERM to a server the terminal's Ctrl-C reached a moment before.
+    dump = tmp_path / "final.csv"
+    server = subprocess.Popen([SERVER, "--port", "0", "--no-web", "--balls", "50", "--dump", str(dump)],
+                              stderr=subprocess.PIPE, text=True)
+    try:
+        line = server.stderr.readline()
+        while "Ctrl-C stops" not in line:
+            assert line, "the server ended before its banner"
+            line = server.stderr.readline()
+        time.sleep(1)  # some balls poured in
+        server.send_signal(signal.SIGINT)
+        server.send_signal(signal.SIGTERM)
+        assert server.wait(timeout=10) == 0
+        stopped = re.search(r"stopped after \d+ steps, (\d+) balls", server.stderr.read())
+    finally:
+        server.kill()
+        server.wait()
+    assert stopped and int(stopped.group(1)) > 0
+    assert len(dump.read_text().splitlines()) == 1 + int(stopped.group(1))  # a header, then every ball
