@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "server/net/plain_http.h"
 #include "server/net/tcp_session.h"
 #include "server/net/web_session.h"
 
@@ -138,10 +139,7 @@ void NetServer::refuse_full(tcp::socket socket, Kind kind) {
   auto peer = std::make_shared<tcp::socket>(std::move(socket));
   const std::string why = "the server already has its " + std::to_string(info_.limits.max_connections) +
                           " clients (--max-connections); try again later";
-  const std::string http =
-      "HTTP/1.1 503 Service Unavailable\r\nContent-Type: text/plain; charset=utf-8\r\n"
-      "Connection: close\r\nContent-Length: " +
-      std::to_string(why.size() + 1) + "\r\n\r\n" + why + "\n";
+  const std::string http = plain_http_response("503 Service Unavailable", why + "\n");
   auto frame =
       std::make_shared<protocol::Frame>(kind == Kind::web ? protocol::Frame(http.begin(), http.end())
                                                           : protocol::encode_error(wire::ErrorCode::server_full, why));

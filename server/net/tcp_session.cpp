@@ -1,5 +1,7 @@
 #include "server/net/tcp_session.h"
 
+#include "server/net/plain_http.h"
+
 namespace fishtank::net {
 
 namespace asio = boost::asio;
@@ -30,7 +32,10 @@ void TcpSession::do_read() {
                      if (ec) return on_error(ec, "disconnected");
                      received_bytes();
                      if (ending()) return do_drain();
-                     if (!hello_received() && starts_http_request(header_)) return answer_browser();
+                     if (!hello_received() && starts_http_request(header_)) {
+                       answer_browser();
+                       return read_on();  // the rest of the request is drained, as any ending session's
+                     }
                      std::uint32_t body_bytes = 0;
                      const protocol::DecodeResult length = check_length_prefix(header_.data(), &body_bytes);
                      if (!length.ok()) {
@@ -50,10 +55,7 @@ void TcpSession::answer_browser() {
       (web ? "The browser viewer is on port " + std::to_string(web) + " of this machine: put " + std::to_string(web) +
                  " in the address instead.\n"
            : std::string("This server serves no browser viewer (it was started with --no-web).\n"));
-  const std::string response =
-      "HTTP/1.1 400 Bad Request\r\nContent-Type: text/plain; charset=utf-8\r\n"
-      "Content-Length: " +
-      std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n" + body;
+  const std::string response = plain_http_response("400 Bad Request", body);
   answer_in_kind_and_close(std::vector<std::uint8_t>(response.begin(), response.end()),
                            "an HTTP request on the TCP port: told the browser the web viewer's port");
 }

@@ -59,9 +59,24 @@ void WebSession::answer_fishtank_client() {
                                  std::to_string(tcp) + " (the 'listening on' line of its log)"));
   // Written as is, not through the Session: a connection before the upgrade carries no frames.
   asio::async_write(http_.socket(), asio::buffer(*error),
-                    [this, self = shared_from_this(), error](beast::error_code, std::size_t) {
-                      close("a Fishtank client on the web port: told it the TCP port");
+                    [this, self = shared_from_this(), error](beast::error_code ec, std::size_t) {
+                      if (ec) return on_error(ec, "disconnected");
+                      beast::error_code ignored;
+                      http_.socket().shutdown(asio::ip::tcp::socket::shutdown_send, ignored);
+                      drain_before_upgrade();
                     });
+}
+
+// The peer's close ends it (--hello-timeout at the latest): closing with its bytes unread would reset the
+// connection, and the peer could lose the Error that says why.
+void WebSession::drain_before_upgrade() {
+  buffer_.consume(buffer_.size());
+  http_.socket().async_read_some(buffer_.prepare(1024),
+                                 [this, self = shared_from_this()](beast::error_code ec, std::size_t) {
+                                   if (ec)
+                                     return on_error(ec, "a Fishtank client on the web port: told it the TCP port");
+                                   drain_before_upgrade();
+                                 });
 }
 
 void WebSession::on_request() {

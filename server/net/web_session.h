@@ -44,6 +44,7 @@ class WebSession final : public Session {
   // A fishtank-viewer or client given the web port: an Error frame naming the TCP port, then the end.
   bool reads_as_fishtank_frame() const;
   void answer_fishtank_client();
+  void drain_before_upgrade();
   void respond_text(boost::beast::http::status status, const std::string& body, bool keep_alive,
                     const char* type = "text/html; charset=utf-8");
   template <class Body>
