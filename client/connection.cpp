@@ -66,29 +66,28 @@ void Connection::do_read() {
   // A limited rate reads 20 ms of it at a time, so the bytes arrive as evenly as over a slow link.
   const std::size_t chunk =
       read_rate_ > 0.0 ? std::clamp<std::size_t>(read_rate_ / 50.0, 1024, read_buffer_.size()) : read_buffer_.size();
-  socket_.async_read_some(asio::buffer(read_buffer_.data(), chunk), [this, self = shared_from_this()](
-                                                                        boost::system::error_code ec, std::size_t n) {
-    if (ec)
-      return fail(ec == asio::error::eof ? closed_by_server_text(stats_.errors.empty() ? "" : stats_.errors.back())
-                                         : ec.message());
-    stats_.bytes_received += n;
-    reader_.append(read_buffer_.data(), n);
-    while (std::optional<protocol::DecodeResult> frame = reader_.next()) {
-      if (!frame->ok()) {
-        stats_.errors.push_back("bad frame from the server: " + frame->why);
-        if (frame->stream_broken()) return fail("bad frame from the server: " + frame->why);
-        continue;
-      }
-      handle(*frame->message);
-    }
-    if (closed_) return;
-    if (read_rate_ <= 0.0) return do_read();
-    read_pause_.expires_after(
-        std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(n / read_rate_)));
-    read_pause_.async_wait([this, self](boost::system::error_code e) {
-      if (!e && !closed_) do_read();
-    });
-  });
+  socket_.async_read_some(asio::buffer(read_buffer_.data(), chunk),
+                          [this, self = shared_from_this()](boost::system::error_code ec, std::size_t n) {
+                            if (ec)
+                              return fail(ec == asio::error::eof ? closed_by_server_text(farewell_) : ec.message());
+                            stats_.bytes_received += n;
+                            reader_.append(read_buffer_.data(), n);
+                            while (std::optional<protocol::DecodeResult> frame = reader_.next()) {
+                              if (!frame->ok()) {
+                                stats_.errors.push_back("bad frame from the server: " + frame->why);
+                                if (frame->stream_broken()) return fail("bad frame from the server: " + frame->why);
+                                continue;
+                              }
+                              handle(*frame->message);
+                            }
+                            if (closed_) return;
+                            if (read_rate_ <= 0.0) return do_read();
+                            read_pause_.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                std::chrono::duration<double>(n / read_rate_)));
+                            read_pause_.async_wait([this, self](boost::system::error_code e) {
+                              if (!e && !closed_) do_read();
+                            });
+                          });
 }
 
 void Connection::handle(const wire::Message& message) {
@@ -119,10 +118,9 @@ void Connection::handle(const wire::Message& message) {
       break;
     case wire::Payload::Error: {
       const wire::Error& e = *message.payload_as_Error();
-      // A code newer than this client has no name here: its number instead.
-      const char* name = wire::EnumNameErrorCode(e.code());
-      stats_.error_codes.push_back(*name ? name : std::to_string(static_cast<int>(e.code())));
+      stats_.error_codes.push_back(protocol::error_code_name(e.code()));
       stats_.errors.push_back(stats_.error_codes.back() + ": " + server_text(e.message()->str()));
+      if (protocol::ends_connection(e.code())) farewell_ = stats_.errors.back();
       if (e.code() == wire::ErrorCode::player_idle) player_id_.reset();  // the sphere was freed
       break;
     }

@@ -112,6 +112,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
   bool welcomed_ = false;
   bool closed_ = false;
   std::string close_reason_;
+  std::string farewell_;  // the Error that ends the connection, "code: message", once it came
   std::optional<std::uint32_t> player_id_;
   std::optional<std::uint32_t> ahead_in_line_;
   std::uint32_t worker_threads_ = 0;

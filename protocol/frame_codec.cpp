@@ -362,6 +362,29 @@ std::uint32_t max_frame_bytes(Direction to) {
   return to == Direction::to_server ? kMaxClientFrameBytes : kMaxServerFrameBytes;
 }
 
+std::string error_code_name(wire::ErrorCode code) {
+  const char* name = wire::EnumNameErrorCode(code);
+  return *name ? name : std::to_string(static_cast<int>(code));
+}
+
+bool ends_connection(wire::ErrorCode code) {
+  using C = wire::ErrorCode;
+  switch (code) {
+    case C::malformed_frame:
+    case C::version_mismatch:
+    case C::expected_hello:
+    case C::too_slow:
+    case C::server_full:
+    case C::hello_timeout:
+    case C::idle_timeout:
+    case C::command_flood:
+    case C::wrong_port:
+      return true;
+    default:
+      return false;
+  }
+}
+
 DecodeResult check_length_prefix(const std::uint8_t prefix[kLengthPrefixBytes], Direction to,
                                  std::uint32_t* body_bytes) {
   const std::uint32_t length = std::uint32_t{prefix[0]} | std::uint32_t{prefix[1]} << 8 |

@@ -117,6 +117,10 @@ Frame encode_delta_snapshot(const SnapshotHeader& header, const DeltaReference& 
                             std::size_t players);
 
 Frame encode_error(wire::ErrorCode code, std::string_view message);
+// An Error's code as clients print it: its name, or its number where it is newer than this build.
+std::string error_code_name(wire::ErrorCode code);
+// Whether an Error of this code is the server's last word on the connection (a disconnect follows).
+bool ends_connection(wire::ErrorCode code);
 Frame encode_pong(std::uint32_t client_time_us);
 // A sphere freed by another client, for this one that waited in line (may_control: under the policy, now).
 Frame encode_player_granted(std::uint32_t player_id, bool may_control);

@@ -112,7 +112,7 @@ void NetClient::do_connect() {
 
 void NetClient::lose(const std::string& why) {
   ++generation_;
-  last_server_error_.clear();
+  farewell_.clear();
   error_code ignored;
   socket_.close(ignored);
   write_queue_.clear();
@@ -133,7 +133,7 @@ void NetClient::do_read_prefix() {
   const std::uint64_t gen = generation_;
   asio::async_read(socket_, asio::buffer(prefix_), [this, gen](error_code ec, std::size_t) {
     if (gen != generation_) return;
-    if (ec == asio::error::eof) return lose(closed_by_server_text(last_server_error_));
+    if (ec == asio::error::eof) return lose(closed_by_server_text(farewell_));
     if (ec) return lose("receive failed: " + ec.message());
     std::uint32_t body_bytes = 0;
     protocol::DecodeResult r =
@@ -199,8 +199,7 @@ void NetClient::on_frame() {
     case wire::Payload::Error: {
       const wire::Error& e = *m.payload_as_Error();
       const std::string text = server_text(e.message()->str());  // present: decode_frame checks
-      const char* code = wire::EnumNameErrorCode(e.code());      // "" for a code newer than this viewer
-      last_server_error_ = (*code ? code : std::to_string(static_cast<int>(e.code()))) + ": " + text;
+      if (protocol::ends_connection(e.code())) farewell_ = protocol::error_code_name(e.code()) + ": " + text;
       // Why this viewer observes stays on the HUD's Player row, not only for a notice's few seconds.
       if (info_ && (e.code() == wire::ErrorCode::player_limit || e.code() == wire::ErrorCode::player_idle))
         return change_info(

@@ -93,9 +93,9 @@ class NetClient {
   // Bumped whenever a connection ends, so handlers of an old socket that
   // complete late recognise themselves as stale.
   std::uint64_t generation_ = 0;
-  bool connected_ = false;         // Welcome received on the current connection
-  std::string last_server_error_;  // the current connection's last Error, "code: message": why it may close
-  bool watching_ = true;           // what the server was last asked (Watching); every connection starts on
+  bool connected_ = false;  // Welcome received on the current connection
+  std::string farewell_;    // the Error that ends the current connection, "code: message", once it came
+  bool watching_ = true;    // what the server was last asked (Watching); every connection starts on
   std::uint8_t prefix_[protocol::kLengthPrefixBytes] = {};
   protocol::Frame frame_;
   std::deque<protocol::Frame> write_queue_;  // front is in flight
