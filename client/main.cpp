@@ -100,9 +100,10 @@ int main(int argc, char** argv) {
     std::cerr << "fishtank-client: the server dropped " << s.dropped << " of " << s.clients << " connections\n";
     return 1;
   }
-  // player_limit only says a client observes while it waits in line; any other Error refused what was asked.
+  // player_limit and player_idle only say a client observes (in line, or its unmoved sphere freed); any
+  // other Error refused what was asked.
   if (std::any_of(s.error_codes.begin(), s.error_codes.end(),
-                  [](const std::string& c) { return c != "player_limit"; })) {
+                  [](const std::string& c) { return c != "player_limit" && c != "player_idle"; })) {
     std::cerr << "fishtank-client: the server refused what was asked (its reasons are above)\n";
     return 1;
   }
