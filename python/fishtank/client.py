@@ -164,7 +164,8 @@ class Client:
         self._unraised = []  # refusals not yet raised to the caller
         self.welcome = None
         self.ahead_in_line = None  # in line for a sphere: how many clients are before this one (InLine)
-        self._send(_frame(Payload.Payload.Hello, lambda b: self._hello(b, name, player)))
+        # Not _send: its wait for the reader's reason would wait for a reader not started yet.
+        self._send_frame(_frame(Payload.Payload.Hello, lambda b: self._hello(b, name, player)))
         self._reader = threading.Thread(target=self._read, name=f"fishtank reader {self.address}", daemon=True)
         self._reader.start()
         try:

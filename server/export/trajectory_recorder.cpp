@@ -25,8 +25,11 @@ std::string TrajectoryRecorder::finish(const World& world) {
   char why[160];
   std::snprintf(why, sizeof why, "no frame recorded: the run ended at t = %.3f s with %u balls", world.time(),
                 world.ball_count());
-  const std::string reason =
-      world.ball_count() == 0 ? "" : ", before --record-from " + number_text(options_.from) + " s";
+  const std::string reason = world.ball_count() == 0 ? ""
+                             : world.time() < options_.from
+                                 ? ", before --record-from " + number_text(options_.from) + " s"
+                                 : ", " + std::to_string(world.pending()) +
+                                       " still queued to pour in (--record-constant-count waits for them)";
   const std::string error = close_with("");
   return error.empty() ? why + reason + "; " + options_.path + " is empty" : error;
 }

@@ -45,7 +45,7 @@ void PhysicsLink::at_step_boundary(World& world, const LoopStatus& status) {
       reply_({command.client_id,
               ControlRefusedReply{ControlRefusedReply::Why::superseded,
                                   "Reset not carried out: another client's Reset reached the server at the same "
-                                  "moment and replaced it; send it again to have it"}});
+                                  "moment, and of such a burst only the last is taken; send it again to have it"}});
     }
   }
 

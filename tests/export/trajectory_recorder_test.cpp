@@ -123,6 +123,21 @@ TEST_CASE("a run that ends before --record-from's second records nothing, says w
   CHECK(recorder.frames() == 0);
 }
 
+TEST_CASE("a constant-count recording whose run ends while balls still pour in says that is why it is empty",
+          "[export][record]") {
+  World world(PhysicsParams{}, kSseKernels, 1, 3);
+  world.add_balls(3000);
+  const auto path = temp_file("fishtank-record-mid-pour.lammpstrj");
+  TrajectoryRecorder recorder({path.string(), 20, 0.0, true});
+  REQUIRE(recorder.open().empty());
+  CHECK(run(world, recorder, 50).empty());
+  REQUIRE(world.pending() > 0);
+  CHECK_THAT(recorder.finish(world),
+             Catch::Contains(" still queued to pour in (--record-constant-count waits for them); " + path.string() +
+                             " is empty"));
+  CHECK(recorder.failed());
+}
+
 TEST_CASE("a constant-count recording starts once the pour is in and ends, saying why, when the count changes",
           "[export][record]") {
   World world(PhysicsParams{}, kSseKernels, 1, 3);
