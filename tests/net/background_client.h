@@ -52,7 +52,7 @@ class BackgroundClient {
   std::thread thread_;
 };
 
-// Snapshots a client receives while `during` runs, per second.
+// Snapshots a client receives while `during` runs and for the rest of a second at least, per second.
 double snapshot_rate(const BackgroundClient& client, const std::function<void()>& during);
 
 }  // namespace fishtank::test
