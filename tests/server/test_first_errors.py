@@ -221,17 +221,23 @@ def test_a_server_given_one_core_starts_one_thread():
     assert "oversubscribed" not in run.stderr
 
 
+def _started(flags):
+    """A server on an ephemeral port with these flags, once its banner says Ctrl-C stops it."""
+    server = subprocess.Popen([SERVER, "--port", "0", "--no-web", *flags], stderr=subprocess.PIPE, text=True)
+    line = server.stderr.readline()
+    while "Ctrl-C stops" not in line:
+        assert line, "the server ended before its banner"
+        line = server.stderr.readline()
+    return server
+
+
 def test_a_second_ctrl_c_ends_a_server_that_is_writing_its_final_files(tmp_path):
     # A million balls' final files take the server a second or more to write: long enough to interrupt.
-    server = subprocess.Popen([SERVER, "--port", "0", "--no-web", "--scene", "wide", "--balls", "1000000",
-                               "--dump", str(tmp_path / "final.csv"), "--export-lammps", str(tmp_path / "lammps")],
-                              stderr=subprocess.PIPE, text=True)
+    server = _started(["--scene", "wide", "--balls", "1000000", "--dump", str(tmp_path / "final.csv"),
+                       "--export-lammps", str(tmp_path / "lammps")])
     try:
-        line = server.stderr.readline()
-        while "Ctrl-C stops" not in line:
-            assert line, "the server ended before its banner"
-            line = server.stderr.readline()
         server.send_signal(signal.SIGINT)
+        line = ""
         while "stopped after" not in line:  # it stops stepping and goes on to the files
             line = server.stderr.readline()
             assert line, "the server ended without saying it stopped"
@@ -246,13 +252,8 @@ def test_a_second_ctrl_c_ends_a_server_that_is_writing_its_final_files(tmp_path)
 def test_a_sigterm_after_ctrl_c_lets_the_server_write_its_final_files(tmp_path):
     # scripts/run's exit trap sends SIGTERM to a server the terminal's Ctrl-C reached a moment before.
     dump = tmp_path / "final.csv"
-    server = subprocess.Popen([SERVER, "--port", "0", "--no-web", "--balls", "50", "--dump", str(dump)],
-                              stderr=subprocess.PIPE, text=True)
+    server = _started(["--balls", "50", "--dump", str(dump)])
     try:
-        line = server.stderr.readline()
-        while "Ctrl-C stops" not in line:
-            assert line, "the server ended before its banner"
-            line = server.stderr.readline()
         time.sleep(1)  # some balls poured in
         server.send_signal(signal.SIGINT)
         server.send_signal(signal.SIGTERM)
