@@ -4,7 +4,9 @@
 #include "server/net/client_protocol.h"
 
 #include <catch2/catch.hpp>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "common/printable_text.h"
 
@@ -86,4 +88,60 @@ TEST_CASE("a WebSocket message is a frame without its length prefix, under the s
   const net::Outcome refused = web.on_unprefixed_frame(garbage.data(), garbage.size());
   CHECK(refused.disconnect);
   CHECK_THAT(refused.log, Catch::StartsWith("malformed_frame"));
+}
+
+TEST_CASE("an Error code ends the connection (protocol::ends_connection) exactly where the server disconnects after it",
+          "[net]") {
+  const net::ServerInfo info;
+  const auto t0 = net::ClientProtocol::Clock::now();
+  const protocol::Frame hello = protocol::encode_hello("viewer", false, false);
+  const auto welcomed = [&] {
+    auto client = std::make_unique<net::ClientProtocol>(1, info);
+    client->on_frame(hello.data(), hello.size(), t0);
+    client->on_reply({1, net::JoinedReply{}});
+    return client;
+  };
+  std::vector<net::Outcome> outcomes;
+  {
+    net::ClientProtocol fresh(1, info);
+    const protocol::Frame ping = protocol::encode_ping(1);
+    outcomes.push_back(fresh.on_frame(ping.data(), ping.size(), t0));  // expected_hello
+  }
+  {
+    net::ClientProtocol old(1, info);
+    const protocol::Frame other = protocol::encode_hello("viewer", false, false, protocol::kProtocolVersion + 1);
+    outcomes.push_back(old.on_frame(other.data(), other.size(), t0));  // version_mismatch
+  }
+  outcomes.push_back(net::ClientProtocol(1, info).on_hello_timeout());
+  {
+    const std::uint8_t huge[4] = {0xff, 0xff, 0xff, 0x7f};  // malformed_frame
+    std::uint32_t body = 0;
+    outcomes.push_back(
+        welcomed()->on_broken_stream(protocol::check_length_prefix(huge, protocol::Direction::to_server, &body)));
+  }
+  for (bool sent : {false, true}) {
+    outcomes.push_back(welcomed()->on_write_stalled(sent));
+    outcomes.push_back(welcomed()->on_acks_stopped(sent));
+  }
+  outcomes.push_back(welcomed()->on_replies_piling_up(100));
+  outcomes.push_back(welcomed()->on_evicted("the server needs the place"));
+  outcomes.push_back(welcomed()->on_queue_full());
+  outcomes.push_back(welcomed()->on_player_idle());
+  outcomes.push_back(
+      welcomed()->on_reply({1, net::ControlRefusedReply{net::ControlRefusedReply::Why::superseded, "x"}}));
+
+  int disconnects = 0;
+  for (const net::Outcome& outcome : outcomes) {
+    REQUIRE_FALSE(outcome.replies.empty());
+    const protocol::Frame& last = outcome.replies.back();
+    const protocol::DecodeResult decoded =
+        protocol::decode_frame(last.data(), last.size(), protocol::Direction::to_client);
+    REQUIRE(decoded.ok());
+    REQUIRE(decoded.message->payload_type() == wire::Payload::Error);
+    const wire::ErrorCode code = decoded.message->payload_as_Error()->code();
+    INFO(protocol::error_code_name(code));
+    CHECK(protocol::ends_connection(code) == outcome.disconnect);
+    disconnects += outcome.disconnect;
+  }
+  CHECK(disconnects == 10);
 }
