@@ -211,8 +211,9 @@ double measured_restitution(const Method& method, const SceneConfig& config, dou
                             double phase) {
   const float ra = 0.5f * kBallKinds[kind_a].diameter, rb = 0.5f * kBallKinds[kind_b].diameter;
   const double ma = kBallKinds[kind_a].mass, mb = kBallKinds[kind_b].mass;
-  const double gap = kHeadOnGap + phase * 2.0 * kHeadOnSpeed * dt;
-  const Problem problem{contact_for(config, ma * mb / (ma + mb), config.restitution), 0.0, -gap, 2.0 * kHeadOnSpeed};
+  const double gap = kHeadOnGap + phase * 2.0 * config.head_on_speed * dt;
+  const Problem problem{contact_for(config, ma * mb / (ma + mb), config.restitution), 0.0, -gap,
+                        2.0 * config.head_on_speed};
 
   WorldScene scene;
   scene.params.restitution = static_cast<float>(config.restitution);
@@ -220,7 +221,7 @@ double measured_restitution(const Method& method, const SceneConfig& config, dou
   // Small enough that building the World's grid costs little next to the steps.
   scene.params.tank.min = {-5.0f, -5.0f, -5.0f};
   scene.params.tank.max = {5.0f, 5.0f, 5.0f};
-  const float half_gap = static_cast<float>(gap / 2), speed = static_cast<float>(kHeadOnSpeed);
+  const float half_gap = static_cast<float>(gap / 2), speed = static_cast<float>(config.head_on_speed);
   scene.balls = {{kind_a, {-ra - half_gap, 0.0f, 0.0f}, {speed, 0.0f, 0.0f}},
                  {kind_b, {rb + half_gap, 0.0f, 0.0f}, {-speed, 0.0f, 0.0f}}};
   scene.overlap = [ra, rb](const World& w) { return double(ra + rb) - (w.ball(1).pos.x - w.ball(0).pos.x); };
@@ -243,16 +244,15 @@ double measured_restitution(const Method& method, const SceneConfig& config, dou
 }
 
 double head_on_pair_error(const Method& method, const SceneConfig& config, double dt, int kind_a, int kind_b) {
-  const double ma = kBallKinds[kind_a].mass, mb = kBallKinds[kind_b].mass;
-  const Rebound exact = exact_rebound(ma, kHeadOnSpeed, mb, -kHeadOnSpeed, config.restitution);
+  const double ma = kBallKinds[kind_a].mass, mb = kBallKinds[kind_b].mass, v = config.head_on_speed;
+  const Rebound exact = exact_rebound(ma, v, mb, -v, config.restitution);
   double worst = 0.0;
   for (int p = 0; p < kHeadOnPhases; ++p) {
-    const double w =
-        -2.0 * kHeadOnSpeed * measured_restitution(method, config, dt, kind_a, kind_b, double(p) / kHeadOnPhases);
+    const double w = -2.0 * v * measured_restitution(method, config, dt, kind_a, kind_b, double(p) / kHeadOnPhases);
     // Forces are equal and opposite, so the momentum fixes each velocity from the relative one.
-    const double momentum = (ma - mb) * kHeadOnSpeed;
+    const double momentum = (ma - mb) * v;
     const double va = (momentum + mb * w) / (ma + mb), vb = (momentum - ma * w) / (ma + mb);
-    worst = std::max(worst, std::max(std::fabs(va - exact.v1), std::fabs(vb - exact.v2)) / (2.0 * kHeadOnSpeed));
+    worst = std::max(worst, std::max(std::fabs(va - exact.v1), std::fabs(vb - exact.v2)) / (2.0 * v));
   }
   return worst;
 }

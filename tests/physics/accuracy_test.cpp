@@ -32,8 +32,8 @@ const T& named(const std::vector<T>& all, const std::string& name) {
 
 // Order of the error in dt = t_c / n over n = 10 ... 80 (as the tool fits it),
 // or over the given n.
-double order(const std::string& scene, const std::string& method, std::vector<int> steps = {10, 20, 40, 80}) {
-  const SceneConfig config;
+double order(const std::string& scene, const std::string& method, std::vector<int> steps = {10, 20, 40, 80},
+             const SceneConfig& config = {}) {
   std::vector<double> dt, error;
   for (int n : steps) {
     dt.push_back(contact_duration(static_cast<float>(config.k)) / n);
@@ -77,8 +77,11 @@ TEST_CASE("with the dashpot on the half-step velocity, Verlet rebounds exactly a
 }
 
 TEST_CASE("damped collisions: the World is second order and 20x closer than the half-step dashpot", "[accuracy]") {
-  // Over n = 14 ... 56: below, the errors are not yet asymptotic; above, float32 positions set a floor.
-  CHECK(order("head-on", "world-verlet", {14, 20, 28, 40, 56}) >= 1.9);
+  // Over n = 14 ... 56: below, the errors are not yet asymptotic; above, float32 positions set a floor. At the
+  // figures' 1 m/s that floor, and the CPU's own rsqrt estimate, bend the head-on fit at n = 56; at 4 m/s they do not.
+  SceneConfig fast;
+  fast.head_on_speed = 4.0;
+  CHECK(order("head-on", "world-verlet", {14, 20, 28, 40, 56}, fast) >= 1.9);
   CHECK(order("drop", "world-verlet", {14, 20, 28, 40, 56}) >= 1.9);
   CHECK(order("head-on", "verlet-1d", {14, 20, 28, 40}) < 1.5);
   const SceneConfig config;
