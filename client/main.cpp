@@ -97,7 +97,10 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (s.dropped > 0) {
-    std::cerr << "fishtank-client: the server dropped " << s.dropped << " of " << s.clients << " connections\n";
+    const bool stopped =
+        std::find(s.error_codes.begin(), s.error_codes.end(), "server_stopping") != s.error_codes.end();
+    std::cerr << "fishtank-client: " << (stopped ? "the server stopped, ending " : "the server dropped ") << s.dropped
+              << " of " << s.clients << " connections before --duration ended\n";
     return 1;
   }
   // player_limit and player_idle only say a client observes (in line, or its unmoved sphere freed); any

@@ -379,6 +379,7 @@ bool ends_connection(wire::ErrorCode code) {
     case C::idle_timeout:
     case C::command_flood:
     case C::wrong_port:
+    case C::server_stopping:
       return true;
     default:
       return false;

@@ -238,6 +238,7 @@ int run_server(const fishtank::ServerOptions& o) {
         pace_text(s, control).c_str(), warning.empty() ? "" : "  WARNING: ", warning.c_str());
   };
   fishtank::run_realtime(stepper, loop, g_stop);
+  network.stop(g_stop ? "it was stopped (Ctrl-C or SIGTERM)" : "its --duration ended");
   std::cerr << "fishtank-server: stopped after " << world.steps() << " steps, " << world.ball_count() << " balls\n";
   return write_final_state(world, o, recorder);
 }

@@ -339,17 +339,18 @@ class Client:
         a bare broken pipe, and not only from the second send after it."""
         self._check_open()  # the socket is gone: a send would fail with a bad file descriptor
         with self._changed:
-            if self._ended is not None:
-                raise self._ended
+            self._raise_ended()
         try:
             self._send_frame(frame)
+            return
         except TimeoutError:
             raise self._timed_out() from None
         except OSError as e:
-            with self._changed:  # the reader is about to learn why (the server's farewell, or the reset)
-                if self._changed.wait_for(lambda: self._ended is not None, timeout=1.0):
-                    raise self._ended from None
-            raise ConnectionError(f"the connection to {self.address} failed: {e.strerror or e}") from None
+            failure = e
+        with self._changed:  # the reader is about to learn why (the server's farewell, or the reset)
+            if self._changed.wait_for(lambda: self._ended is not None, timeout=1.0):
+                self._raise_ended()
+        raise ConnectionError(f"the connection to {self.address} failed: {failure.strerror or failure}")
 
     def _send_frame(self, frame):
         with self._send_lock:
@@ -366,8 +367,7 @@ class Client:
                 value = ready()
                 if value:
                     return value
-                if self._ended is not None:
-                    raise self._ended
+                self._raise_ended()
                 left = deadline - time.monotonic()
                 if left <= 0:
                     raise self._timed_out()
@@ -418,8 +418,14 @@ class Client:
     def _check_refusals(self):
         with self._changed:
             self._raise_refusal()
-            if self._ended is not None:
-                raise self._ended
+            self._raise_ended()
+
+    def _raise_ended(self):
+        """Where the connection has ended (under the lock): its last refusal first, if not raised yet (the code
+        that ended it, as FishtankError), then why it ended, at every later call."""
+        if self._ended is not None:
+            self._raise_refusal()
+            raise self._ended
 
     # ---- receiving: the reader thread ----
 
@@ -433,6 +439,7 @@ class Client:
                 except TimeoutError:  # the caller's waits have deadlines of their own
                     continue
                 if not chunk:  # the frames before it, handled on this thread, hold any reason the server gave
+                    self._let_go()
                     raise ConnectionError("the server closed the connection" + self._last_error_text())
                 buffer += chunk
                 while (frame := self._split_frame(buffer)) is not None:
@@ -447,6 +454,14 @@ class Client:
             with self._changed:
                 self._ended = e
                 self._changed.notify_all()
+
+    def _let_go(self):
+        """Ends this side too: the server waits for it (a grace) before its socket, and a stopping server's
+        process, let go."""
+        try:
+            self._sock.shutdown(socket.SHUT_WR)
+        except OSError:
+            pass  # already gone
 
     def _acknowledge(self, tick):
         """Ack with want_keyframe: this client holds no base to decode a delta against, so the next comes in full."""
@@ -528,7 +543,9 @@ class Client:
                     raise error
                 if error.code == "player_idle":  # the sphere was freed; the client observes
                     self.player_id = None
-                if error.code != "player_limit":  # the Welcome says so too: this client observes, in line
+                # player_limit: the Welcome says so too, this client observes, in line. server_stopping refuses
+                # nothing asked: the ConnectionError of every later call carries it.
+                if error.code not in ("player_limit", "server_stopping"):
                     self._unraised.append(error)
             elif kind == Payload.Payload.PlayerGranted:
                 g = PlayerGranted.PlayerGranted()

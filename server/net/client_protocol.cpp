@@ -249,6 +249,10 @@ Outcome ClientProtocol::on_evicted(const std::string& why) {
   return refuse(wire::ErrorCode::server_full, why, /*disconnect=*/true);
 }
 
+Outcome ClientProtocol::on_server_stopping(const std::string& why) {
+  return refuse(wire::ErrorCode::server_stopping, "the server is stopping: " + why, /*disconnect=*/true);
+}
+
 Outcome ClientProtocol::on_reply(const Reply& reply) {
   Outcome out;
   if (const auto* joined = std::get_if<JoinedReply>(&reply.result)) {

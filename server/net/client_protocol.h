@@ -87,6 +87,8 @@ class ClientProtocol {
   Outcome on_acks_stopped(bool sent_meanwhile);
   // The server needs this connection's place for a newcomer (it has not said Hello).
   Outcome on_evicted(const std::string& why);
+  // The server is stopping, for this reason: the last word to every client.
+  Outcome on_server_stopping(const std::string& why);
 
   // A Snapshot with this tick went out to the client.
   void on_snapshot_sent(std::uint32_t tick, std::size_t bytes, Clock::time_point now = Clock::now()) {

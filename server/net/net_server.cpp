@@ -167,7 +167,8 @@ void NetServer::back_off(Listener& listener, Kind kind, const boost::system::err
   });
 }
 
-void NetServer::stop() {
+void NetServer::stop(const std::string& why) {
+  if (stopped_) return;
   stopped_ = true;
   boost::system::error_code ignored;
   for (Listener* listener : {&tcp_, &web_}) {
@@ -176,7 +177,7 @@ void NetServer::stop() {
   }
   // close() calls session_closed(), which erases from these maps: iterate over copies.
   for (const auto& sessions : {sessions_, leaving_})
-    for (const auto& [id, session] : sessions) session->close("server shutting down");
+    for (const auto& [id, session] : sessions) session->say_server_stopping(why);
 }
 
 void NetServer::post_snapshot(SharedSnapshot snapshot) {

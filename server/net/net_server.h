@@ -47,8 +47,8 @@ class NetServer final : public SessionOwner {
   boost::asio::ip::tcp::endpoint local_endpoint() const { return tcp_.acceptor.local_endpoint(); }
   boost::asio::ip::tcp::endpoint web_endpoint() const { return web_.acceptor.local_endpoint(); }
   const StaticFiles* static_files() const { return files_ ? &*files_ : nullptr; }
-  // Io thread: stop accepting and close every session.
-  void stop();
+  // Io thread: stop accepting, and tell every session why before it closes (Session::say_server_stopping).
+  void stop(const std::string& why);
 
   // Any thread.
   void post_snapshot(SharedSnapshot snapshot);

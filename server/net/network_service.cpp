@@ -93,12 +93,17 @@ std::string NetworkService::start() {
   return {};
 }
 
+void NetworkService::stop(const std::string& why) {
+  boost::asio::post(io_, [this, why] { server_.stop(why); });
+}
+
 NetworkService::~NetworkService() {
   boost::asio::post(io_, [this] {
-    server_.stop();
+    server_.stop("it is shutting down");  // where stop() was not called first
     signals_.cancel();
     work_.reset();
   });
+  // io_.run() returns once the last session has closed.
   if (io_thread_.joinable()) io_thread_.join();
 }
 

@@ -37,7 +37,7 @@ class NetworkService {
   // thread's, changed by clients' commands at step boundaries.
   NetworkService(const NetOptions& options, ServerInfo info, RunControl& control, ActiveScene& scene,
                  std::atomic<bool>& stop);
-  // Stops the io thread; call after the physics loop has returned.
+  // Stops the io thread once every client is told (stop()) or its grace has passed.
   ~NetworkService();
 
   // Binds, prints "listening on ADDRESS:PORT" on stderr (and "web viewer on
@@ -49,6 +49,9 @@ class NetworkService {
   void at_step_boundary(World& world, const LoopStatus& status) { link_.at_step_boundary(world, status); }
   // Physics thread: clients, bytes/s out and the network's CPU cost since the last call.
   std::string status();
+  // Once the physics loop has returned: no newcomers, and every client is told why it ends (an Error, server_stopping),
+  // while the final files are written.
+  void stop(const std::string& why);
 
  private:
   void await_second_signal(int first);

@@ -96,6 +96,17 @@ void Session::evict(const std::string& why) {
   carry_out(protocol_.on_evicted(why));
 }
 
+void Session::say_server_stopping(const std::string& why) {
+  if (closed_) return;
+  // One that is ending has had its last word; one without Hello has no one to tell.
+  if (close_after_write_ || !protocol_.hello_received()) return close("server shutting down");
+  server_stopping_ = true;
+  carry_out(protocol_.on_server_stopping(why));
+  if (closed_) return;
+  hard_close_at_ = Clock::now() + kStopGrace;
+  arm_watchdog();
+}
+
 void Session::do_write() {
   if (write_in_flight_ || closed_) return;
   if (!carries_frames()) {
@@ -180,7 +191,8 @@ void Session::check_limits() {
   const Clock::time_point now = Clock::now();
   if (hard_close_at_) {
     if (now >= *hard_close_at_)
-      close(farewell_sent_ ? "disconnected by the server" : "disconnected by the server before it read why");
+      close(farewell_sent_ ? "disconnected by the server; the client had not closed its side within the grace"
+                           : "disconnected by the server before it read why");
     return;
   }
   if (!protocol_.hello_received() && now >= connected_at_ + limit_duration(limits_.hello_timeout_s))

@@ -66,6 +66,8 @@ class Session : public std::enable_shared_from_this<Session> {
   static constexpr std::size_t kMaxQueuedReplies = 64;
   // How long a session that is ending waits for its last Error to be read.
   static constexpr auto kErrorGrace = std::chrono::seconds(2);
+  // Shorter while the server stops: a peer that does not read must not hold the process.
+  static constexpr auto kStopGrace = std::chrono::seconds(1);
 
   Session(const boost::asio::any_io_executor& executor, const boost::asio::ip::tcp::endpoint& peer, std::uint32_t id,
           const ServerInfo& info, SessionOwner& owner);
@@ -78,6 +80,8 @@ class Session : public std::enable_shared_from_this<Session> {
   void deliver(const Reply& reply);
   // Error(server_full) saying why, then the usual end: the server needs the place.
   void evict(const std::string& why);
+  // Error(server_stopping) saying why, then the usual end within kStopGrace; one without Hello closes at once.
+  void say_server_stopping(const std::string& why);
   void close(const std::string& reason);
 
   std::uint32_t id() const { return id_; }
@@ -100,6 +104,7 @@ class Session : public std::enable_shared_from_this<Session> {
   // Sends what waits, e.g. once the transport carries frames.
   void do_write();
   bool ending() const { return close_after_write_; }
+  bool server_stopping() const { return server_stopping_; }
   // A peer speaking another protocol on this port: these bytes, in its protocol, then the usual end.
   void answer_in_kind_and_close(std::vector<std::uint8_t> bytes, const std::string& log);
   SessionOwner& owner() const { return owner_; }
@@ -161,6 +166,7 @@ class Session : public std::enable_shared_from_this<Session> {
 
   bool close_after_write_ = false;
   bool farewell_sent_ = false;  // every reply is out and our side is shut
+  bool server_stopping_ = false;
   bool closed_ = false;
 };
 

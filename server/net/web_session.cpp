@@ -210,7 +210,8 @@ void WebSession::write_next_frame() {
 
 void WebSession::send_farewell() {
   // The read still pending sees the peer's close frame, or the grace period ends the session.
-  ws_->async_close(websocket::close_code::policy_error, [self = shared_from_this()](beast::error_code) {});
+  const auto code = server_stopping() ? websocket::close_code::going_away : websocket::close_code::policy_error;
+  ws_->async_close(code, [self = shared_from_this()](beast::error_code) {});
 }
 
 void WebSession::close_transport() {

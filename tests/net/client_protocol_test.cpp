@@ -125,6 +125,7 @@ TEST_CASE("an Error code ends the connection (protocol::ends_connection) exactly
   }
   outcomes.push_back(welcomed()->on_replies_piling_up(100));
   outcomes.push_back(welcomed()->on_evicted("the server needs the place"));
+  outcomes.push_back(welcomed()->on_server_stopping("its --duration ended"));
   outcomes.push_back(welcomed()->on_queue_full());
   outcomes.push_back(welcomed()->on_player_idle());
   outcomes.push_back(
@@ -143,5 +144,5 @@ TEST_CASE("an Error code ends the connection (protocol::ends_connection) exactly
     CHECK(protocol::ends_connection(code) == outcome.disconnect);
     disconnects += outcome.disconnect;
   }
-  CHECK(disconnects == 10);
+  CHECK(disconnects == 11);
 }

@@ -143,9 +143,15 @@ bool ServerProcess::wait_for_log(const std::string& text, std::chrono::milliseco
   return wait_until([&] { return log().find(text) != std::string::npos; }, timeout);
 }
 
-int ServerProcess::terminate() {
-  if (!running()) return exit_status_;
+void ServerProcess::request_stop() {
+  if (stop_requested_ || !running()) return;
   kill(pid_, SIGTERM);
+  stop_requested_ = true;
+}
+
+int ServerProcess::terminate() {
+  request_stop();
+  if (!running()) return exit_status_;
   const Clock::time_point deadline = Clock::now() + std::chrono::seconds(10);
   while (Clock::now() < deadline && running()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
   if (!reaped_) {

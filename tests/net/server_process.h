@@ -42,7 +42,10 @@ class ServerProcess {
   std::string log() const;
   // Waits (at most `timeout`) until the log has `text`; false when it did not come.
   bool wait_for_log(const std::string& text, std::chrono::milliseconds timeout) const;
-  // SIGTERM, then waits at most 10 s; the exit status, or -1 when it had to be killed.
+  // SIGTERM, without waiting: the server tells its clients why and ends (terminate() then waits).
+  void request_stop();
+  // SIGTERM unless request_stop() sent it (a second one stops at once), then waits at most 10 s;
+  // the exit status, or -1 when it had to be killed.
   int terminate();
 
  private:
@@ -57,6 +60,7 @@ class ServerProcess {
   std::uint16_t port_ = 0;
   std::uint16_t web_port_ = 0;
   bool reaped_ = false;
+  bool stop_requested_ = false;
   int exit_status_ = -1;
 };
 

@@ -99,8 +99,10 @@ bool codes_nothing(const std::string& status) {
 
 }  // namespace
 
-TEST_CASE("several clients each receive snapshots at the snapshot rate and the server stops cleanly on SIGTERM",
-          "[net]") {
+TEST_CASE(
+    "several clients each receive snapshots at the snapshot rate, and on SIGTERM each is told why it ends and "
+    "the server stops cleanly",
+    "[net]") {
   ServerProcess server({"--balls", "500", "--snapshot-rate", "60"});
   Clients clients(server.port());
   std::vector<std::shared_ptr<Connection>> all;
@@ -118,7 +120,31 @@ TEST_CASE("several clients each receive snapshots at the snapshot rate and the s
   }
   CHECK(all[0]->player_id().has_value());
   CHECK_FALSE(all[1]->player_id().has_value());  // observers get no sphere
+
+  server.request_stop();
+  REQUIRE(
+      clients.wait_until([&] { return std::all_of(all.begin(), all.end(), [](const auto& c) { return c->closed(); }); },
+                         std::chrono::seconds(5)));
+  for (auto& c : all) {
+    CHECK(has_error(*c, "server_stopping"));
+    CHECK_THAT(c->close_reason(), Catch::Contains("the server is stopping: it was stopped"));
+  }
   CHECK(server.terminate() == 0);
+}
+
+TEST_CASE("a client that neither reads nor closes does not hold a stopping server past its grace", "[net]") {
+  ServerProcess server({"--balls", "0"});
+  RawSocket stalled(server.port());
+  stalled.send(protocol::encode_hello("stalled", false, false));
+  REQUIRE(server.wait_for_log("welcomed", std::chrono::seconds(5)));
+  server.request_stop();
+  CHECK(server.terminate() == 0);  // -1: it was still running 10 s later
+  CHECK_THAT(server.log(), Catch::Contains("closed: disconnected by the server; the client had not closed its side"));
+  // What it was sent ends with the Error saying why.
+  std::vector<std::uint8_t> received;
+  REQUIRE(stalled.read_until_closed(received, std::chrono::seconds(5)));
+  const std::string text(received.begin(), received.end());
+  CHECK_THAT(text, Catch::Contains("the server is stopping"));
 }
 
 TEST_CASE("every snapshot says how many threads step, at most Welcome's worker threads, and how fast time runs",

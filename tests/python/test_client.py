@@ -5,6 +5,7 @@ bit, a time scale of one half halves the pace); refusals raise FishtankError
 and leave the connection working."""
 
 import os
+import signal
 import socket
 import stat
 import subprocess
@@ -449,6 +450,19 @@ def test_a_connection_the_server_ended_raises_its_reason_at_the_next_call_not_a_
             with pytest.raises(ConnectionError, match="closed the connection \\(command_flood: "):
                 tank.move((1, 0, 0))
         with pytest.raises(ConnectionError, match="command_flood"):
+            tank.snapshot()
+
+
+def test_a_stopping_server_says_why_and_the_client_lets_go_without_making_it_wait(start_server):
+    server = start_server("--balls", "50")
+    with Client("127.0.0.1", server.port) as tank:
+        tank.snapshot()
+        server.process.send_signal(signal.SIGTERM)
+        assert server.process.wait(timeout=10) == 0
+        log = server.text()
+        # The client closed its side on the server's end, so the server did not wait out its grace for it.
+        assert "('fishtank-python') closed: disconnected" in log and "had not closed its side" not in log, log
+        with pytest.raises(ConnectionError, match="server_stopping: the server is stopping: it was stopped"):
             tank.snapshot()
 
 

@@ -288,10 +288,12 @@ test('a page hidden over two seconds asks for no snapshots, and shown again deco
   assert.ok(off.serverBalls > 0 && back.serverBalls >= off.serverBalls);
 });
 
-test('the HUD says "disconnected" when the server stops, and the page reconnects when it returns', async () => {
+test('the HUD says why and "disconnected" when the server stops, and the page reconnects when it returns', async () => {
   const port = server.port;
   await server.stop();
   await waitForState(page, (st) => st.connection !== 'connected', 'the page to notice');
+  const why = /server_stopping: the server is stopping: it was stopped \(Ctrl-C or SIGTERM\); reconnecting/;
+  assert.match(await waitForHud(page, (t) => /server_stopping/.test(t)), why, 'the server\'s last word, kept on close');
   const gone = /disconnected, last update [1-9]\d* s ago/;
   assert.match(await waitForHud(page, (t) => gone.test(t)), gone);
   server = await startServer(SERVER_ARGS, port);

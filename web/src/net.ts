@@ -62,6 +62,8 @@ export class Connection {
   watching = true;  // whether the server is asked for snapshots (Watching)
   private notice = '';
   private noticeTime = 0;
+  // The newest message's words where it was an Error: the server sends nothing after the Error that ends a connection.
+  private lastError = '';
   private socket: WebSocket | null = null;
   private kinds = new Uint8Array(0);
   private readonly received = new ReceivedSnapshots();
@@ -125,6 +127,7 @@ export class Connection {
       this.bytes += e.data.byteLength;
       const m = wire.readMessage(e.data);
       if (!m) return this.lose('the server sent something that is not a Fishtank message');
+      this.lastError = '';
       // JavaScript's FlatBuffers has no verifier: a damaged message throws while it is read.
       try {
         this.handle(m);
@@ -134,7 +137,12 @@ export class Connection {
     };
     socket.onclose = (e: CloseEvent) => {
       if (socket !== this.socket) return;
-      if (this.state === 'connected') this.say(`connection closed${e.reason ? `: ${e.reason}` : ''} (code ${e.code}); reconnecting`);
+      // 1001 (going away) and 1008 (policy) are the server's own end, after the Error that says why.
+      const farewell = (e.code === 1001 || e.code === 1008) && this.lastError;
+      if (farewell) this.say(`${this.lastError}; reconnecting`);
+      else if (this.state === 'connected')
+        this.say(`connection closed${e.reason ? `: ${e.reason}` : ''} (code ${e.code}); reconnecting`);
+      this.lastError = '';
       this.state = 'disconnected';
       this.socket = null;
       setTimeout(() => this.connect(), RECONNECT_MS);
@@ -158,6 +166,7 @@ export class Connection {
       case Payload.Error: {
         const e = m.payload(new WireError()) as WireError;
         const text = `${ErrorCode[e.code()] ?? `error ${e.code()}`}: ${e.message() ?? ''}`;
+        this.lastError = text;
         // Why this page observes stays on the HUD, not only for a notice's few seconds.
         if (e.code() === ErrorCode.player_limit || e.code() === ErrorCode.player_idle) this.observing = text;
         if (e.code() === ErrorCode.player_limit) this.inLine = true;
