@@ -464,6 +464,7 @@ def test_a_stopping_server_says_why_and_the_client_lets_go_without_making_it_wai
         assert "('fishtank-python') closed: disconnected" in log and "had not closed its side" not in log, log
         with pytest.raises(ConnectionError, match="server_stopping: the server is stopping: it was stopped"):
             tank.snapshot()
+    server.stop()  # exited already: this removes its log
 
 
 def test_a_program_that_reads_less_often_than_the_servers_idle_timeout_keeps_its_connection(start_server):
