@@ -364,10 +364,10 @@ class Client:
         with self._changed:
             while True:
                 self._check_open()  # what arrived before close() is not an answer to a later call
+                self._raise_ended()  # nor what arrived before the connection ended: a snapshot not yet taken
                 value = ready()
                 if value:
                     return value
-                self._raise_ended()
                 left = deadline - time.monotonic()
                 if left <= 0:
                     raise self._timed_out()
