@@ -209,9 +209,10 @@ void WebSession::write_next_frame() {
 }
 
 void WebSession::send_farewell() {
-  // The read still pending sees the peer's close frame, or the grace period ends the session.
+  // The close handshake done (the peer's close frame read, the TCP connection torn down), the session ends; the
+  // read still pending then ends as aborted, which says nothing. A peer that never answers meets the grace period.
   const auto code = server_stopping() ? websocket::close_code::going_away : websocket::close_code::policy_error;
-  ws_->async_close(code, [self = shared_from_this()](beast::error_code) {});
+  ws_->async_close(code, [this, self = shared_from_this()](beast::error_code) { close("disconnected by the server"); });
 }
 
 void WebSession::close_transport() {

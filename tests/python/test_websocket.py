@@ -7,6 +7,7 @@ an over-size header gets 431. Frames are built and read with the Python client's
 import asyncio
 import http.client
 import os
+import signal
 import subprocess
 
 import pytest
@@ -14,7 +15,7 @@ import websockets
 
 from fishtank.client import _frame
 from fishtank._protocol import PROTOCOL_VERSION
-from fishtank.wire import Ack, Hello, Message, Payload, Snapshot
+from fishtank.wire import Ack, Error, ErrorCode, Hello, Message, Payload, Snapshot
 
 TOO_BIG = 1009  # RFC 6455: message too big
 
@@ -133,6 +134,33 @@ def test_a_text_message_or_garbage_gets_the_protocols_error_and_an_end(start_ser
     assert _run(refusal("hello")) == [Payload.Payload.Error]
     assert _run(refusal(bytes(range(64)))) == [Payload.Payload.Error]
     assert "malformed_frame" in server.text()
+
+
+def test_a_stopping_server_says_why_closes_with_1001_and_ends_the_session_on_the_close_handshake(start_server):
+    server = start_server("--balls", "50", "--web-port", "0")
+
+    async def stopped():
+        async with _connect(server.web_port) as ws:
+            await ws.send(_hello())
+            await ws.recv()  # the Welcome
+            server.process.send_signal(signal.SIGTERM)
+            last = None
+            with pytest.raises(websockets.ConnectionClosed) as closed:
+                while True:
+                    last = _message(await ws.recv())
+            return last, closed.value.rcvd.code
+
+    last, code = _run(stopped())
+    assert last.PayloadType() == Payload.Payload.Error
+    error = Error.Error()
+    error.Init(last.Payload().Bytes, last.Payload().Pos)
+    assert error.Code() == ErrorCode.ErrorCode.server_stopping
+    assert code == 1001  # going away
+    assert server.process.wait(timeout=10) == 0
+    log = server.text()
+    # Ended by the client's close frame, not by the grace period a client that never answers meets.
+    assert "closed: disconnected by the server\n" in log and "had not closed its side" not in log, log
+    server.stop()  # exited already: this removes its log
 
 
 @pytest.fixture
