@@ -57,7 +57,7 @@ TunedStepper::TunedStepper(World& world, bool tune) : world_(world), epoch_(Cloc
 }
 
 void TunedStepper::step() {
-  one_thread_steps_ += world_.thread_limit() == 1;
+  one_thread_steps_ += world_.stepping_threads() == 1;
   if (!tuner_) {
     world_.step();
     return;

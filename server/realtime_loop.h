@@ -7,6 +7,7 @@
 // It picks the thread count the steps use as the machine's load changes
 // (TunedStepper), which the benchmark's unpaced steps use too.
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -28,8 +29,8 @@ class TunedStepper {
 
   World& world() const { return world_; }
   void step();
-  // The threads the steps use: the tuner's choice between its probes.
-  int threads() const { return tuner_ ? tuner_->chosen() : world_.thread_limit(); }
+  // The threads the steps use: the tuner's choice between its probes, one where the balls are too few to split.
+  int threads() const { return std::min(tuner_ ? tuner_->chosen() : world_.thread_limit(), world_.stepping_threads()); }
   // While tuning: the cores work in other sessions keeps busy (MachineLoad::crowding), below 0 until measured.
   double crowding_cores() const { return tuner_ && machine_load_.measured() ? machine_load_.crowding() : -1.0; }
   std::uint64_t steps_on_one_thread() const { return one_thread_steps_; }

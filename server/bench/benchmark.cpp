@@ -60,7 +60,7 @@ nlohmann::json time_steps(TunedStepper& stepper, const BenchSpec& spec, const Se
   j["simd"] = world.kernels().simd;
   j["threads"] = world.threads();
   j["thread_shares"] = world.thread_shares();  // of the items the timed steps' passes computed
-  // The thread tuner's choice: the fraction of the timed steps taken on one thread.
+  // The fraction of the timed steps taken on one thread: the tuner's choice, or too few balls to split.
   j["one_thread_step_fraction"] =
       double(stepper.steps_on_one_thread() - one_thread_before) / std::max<std::uint64_t>(1, spec.steps);
   // Cores work in other sessions kept busy at the end (MachineLoad), which keeps the steps on one thread;

@@ -148,6 +148,10 @@ void WorkerPool::wait_for_chunks() {
 
 void WorkerPool::run(std::uint32_t count, const Phase& phase) { run(count, phase, granule_, kMinItemsPerThread); }
 
+int WorkerPool::threads_for(std::uint32_t count) const {
+  return std::max(1, static_cast<int>(std::min<std::uint32_t>(count / kMinItemsPerThread, active_limit_)));
+}
+
 void WorkerPool::run_costly(std::uint32_t count, std::uint32_t min_per_thread, const Phase& phase) {
   run(count, phase, 1, std::max(1u, min_per_thread));
 }

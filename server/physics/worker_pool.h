@@ -48,6 +48,8 @@ class WorkerPool {
   // Passes use at most this many threads (1..threads()); the others stay idle.
   void set_active_limit(int limit);
   int active_limit() const { return active_limit_; }
+  // The threads a run() over `count` items takes now: the active limit, fewer where the items are too few to split.
+  int threads_for(std::uint32_t count) const;
   // Runs phase on `count` items, in chunks claimed by the active threads.
   void run(std::uint32_t count, const Phase& phase);
   // For costly items (a strayed ball's check): split from `min_per_thread` per thread, any chunk length.

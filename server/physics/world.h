@@ -132,6 +132,8 @@ class World {
   // chooses it).
   void set_thread_limit(int limit) { pool_.set_active_limit(limit); }
   int thread_limit() const { return pool_.active_limit(); }
+  // The threads a step's passes over the balls split over now: the limit, or one for too few balls.
+  int stepping_threads() const { return pool_.threads_for(ball_count()); }
   // Each thread's fraction of the items of every pass since reset_thread_shares().
   std::vector<double> thread_shares() const { return pool_.shares(); }
   void reset_thread_shares() { pool_.reset_shares(); }

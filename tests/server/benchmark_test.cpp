@@ -97,3 +97,28 @@ TEST_CASE("the benchmark report holds every figure asked for, consistent with th
   CHECK(j["pile_top"].get<double>() <= 40.0);
   CHECK(j["settle"]["settled"] == settled.settled);
 }
+
+TEST_CASE("a world of too few balls to split steps on one thread and says so, more balls on every thread", "[bench]") {
+  for (const std::uint32_t balls : {2000u, 2048u}) {
+    BenchSpec spec;
+    spec.scene.name = "wide";
+    spec.scene.balls = balls;
+    spec.steps = 4;
+    spec.windows = 1;
+    PhysicsParams params;
+    params.tank = scene_tank(spec.scene);
+    World world(params, kSseKernels, 2, spec.scene.seed);
+    REQUIRE(populate(world, spec.scene).empty());
+    REQUIRE(world.ball_count() == balls);
+    TunedStepper fixed(world, false);  // as --fixed-threads: the limit stays at both threads
+    const bool split = balls >= 2048;
+    INFO(balls << " balls");
+    CHECK(fixed.threads() == (split ? 2 : 1));
+    const nlohmann::json j = time_steps(fixed, spec, SettleReport{});
+    CHECK(j["threads"] == 2);  // the pool's threads
+    CHECK(j["one_thread_step_fraction"].get<double>() == (split ? 0.0 : 1.0));
+    // Where the balls were too few the second thread computed nothing (where they were not, a busy machine
+    // may still leave it nothing: the caller takes a late worker's chunks).
+    if (!split) CHECK(j["thread_shares"][1].get<double>() == 0.0);
+  }
+}
