@@ -225,6 +225,7 @@ int run_server(const fishtank::ServerOptions& o) {
   loop.status_interval = o.status_interval;
   loop.batch_seconds = std::min(0.004, 1.0 / o.snapshot_rate);  // 4 ms, or one snapshot interval if shorter
   loop.control = &control;
+  if (!o.record.path.empty()) loop.boundary_every = o.record.every;
   loop.at_step_boundary = [&](fishtank::World& w, const fishtank::LoopStatus& s) {
     network.at_step_boundary(w, s);
     if (const std::string note = recorder.at_step_boundary(w); !note.empty()) spdlog::warn("{}", note);

@@ -106,7 +106,11 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
     // snapshots, status and commands keep their rate whatever a step costs.
     const Clock::time_point budget_end =
         busy_start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.batch_seconds));
-    auto within_budget = [&](std::uint64_t done) { return done == 0 || Clock::now() < budget_end; };
+    auto within_budget = [&](std::uint64_t done) {
+      if (done == 0) return true;
+      if (options.boundary_every > 0 && world.steps() % options.boundary_every == 0) return false;
+      return Clock::now() < budget_end;
+    };
     std::uint64_t batch_steps = 0;
     if (control.paused) {
       for (; control.steps_to_run > 0 && within_budget(batch_steps); --control.steps_to_run, ++batch_steps)

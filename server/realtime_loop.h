@@ -83,6 +83,9 @@ struct LoopOptions {
   std::function<void(World&, const LoopStatus&)> at_step_boundary;
   // Read before each batch, after at_step_boundary; null: always real time.
   RunControl* control = nullptr;
+  // Nonzero: a batch also ends at every step that is a multiple of it, so at_step_boundary sees that step
+  // (a recording's frames).
+  std::uint64_t boundary_every = 0;
 };
 
 void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::atomic<bool>& stop);

@@ -12,7 +12,7 @@ std::string TrajectoryRecorder::open() {
 }
 
 std::string TrajectoryRecorder::at_step_boundary(const World& world) {
-  return world.steps() < next_frame_ ? "" : write(world);
+  return world.steps() % options_.every != 0 ? "" : write(world);
 }
 
 std::string TrajectoryRecorder::finish(const World& world) {
@@ -59,7 +59,6 @@ std::string TrajectoryRecorder::write(const World& world) {
     count_ = world.ball_count();
   }
   last_step_ = world.steps();
-  next_frame_ = world.steps() + options_.every;
   std::string error = writer_.write_frame(world);
   if (!error.empty()) {
     ended_ = failed_ = true;

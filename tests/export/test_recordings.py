@@ -1,6 +1,6 @@
 """Recordings made by the real server (--record) open in the analysis tools
 people use, read with Debian's python3-ase and python3-mdanalysis: a pour from
-t = 0 in ASE, frame by frame, with the count, box and positions the file holds
+t = 0 in ASE, frame by frame at every N-th step, with the count, box and positions the file holds
 and the final frame equal to --dump's CSV; a settled tank recorded with
 --record-constant-count in MDAnalysis, every frame's positions, velocities and
 box. FISHTANK_SERVER names the server executable."""
@@ -56,6 +56,8 @@ def test_a_pour_recorded_from_t0_opens_in_ase_frame_by_frame_and_ends_at_the_dum
     assert counts == [rows.shape[0] for _, rows in written]
     assert counts[0] > 0 and counts[0] < balls  # no empty frame, and the pour seen under way
     assert all(a <= b for a, b in zip(counts, counts[1:]))  # a pour only adds
+    steps = [step for step, _ in written]
+    assert steps[:-1] == list(range(50, 50 * len(steps), 50))  # every 50th step; the last frame is the final state
     assert counts[-1] == balls == final.shape[0]
     for atoms, (step, rows) in zip(images, written):
         assert np.allclose(atoms.cell.lengths(), TANK_SIZE) and np.allclose(atoms.get_celldisp().ravel(), TANK_LO)
@@ -90,7 +92,8 @@ def test_a_settled_tank_recorded_with_a_constant_count_opens_in_mdanalysis_with_
         assert np.abs(ts.velocities).max() < 0.01  # settled: every ball at rest on the floor
     steps = [step for step, _ in written]
     assert steps[0] * dt >= start * (1 - 1e-3)  # nothing before --record-from
-    assert all(b - a >= every for a, b in zip(steps[:-2], steps[1:-1]))  # the last frame is the final state
+    assert all(step % every == 0 for step in steps[:-1])  # the last frame is the final state
+    assert all(b - a == every for a, b in zip(steps[:-2], steps[1:-1]))
     assert universe.atoms.types.astype(int).tolist() == final[:, 6].astype(int).tolist()
 
     # The last frame is the state --dump wrote.

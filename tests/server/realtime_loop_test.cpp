@@ -165,3 +165,31 @@ TEST_CASE("the rates seen between batches cover the last second, however far apa
   CHECK(seen.last_boundary.time_scale == Approx(1.0).margin(0.1));
   CHECK(seen.last_boundary.load > 0.0);
 }
+
+TEST_CASE("a batch ends at every multiple of boundary_every, running and paused, so a recording gets each",
+          "[server][loop]") {
+  World world(with_stiffness(25000.0f), kSseKernels, 1, 5);
+  place_lattice(world, 100);
+  RunControl control;
+  LoopOptions options;
+  options.control = &control;
+  options.duration = 0.4;
+  options.boundary_every = 7;
+  std::vector<std::uint64_t> boundaries;  // the step at each at_step_boundary
+  options.at_step_boundary = [&](World& w, const LoopStatus&) {
+    boundaries.push_back(w.steps());
+    if (w.steps() >= 150 && !control.paused) {  // then paused, a run of asked-for steps back to back
+      control.paused = true;
+      control.steps_to_run = 100;
+    }
+  };
+  const std::atomic<bool> stop{false};
+  TunedStepper stepper(world, false);
+  run_realtime(stepper, options, stop);
+  REQUIRE(control.steps_to_run == 0);
+  REQUIRE(world.steps() >= 250);
+  for (std::uint64_t step = 0; step + 7 <= world.steps(); step += 7) {
+    INFO("step " << step);
+    CHECK(std::find(boundaries.begin(), boundaries.end(), step) != boundaries.end());
+  }
+}
