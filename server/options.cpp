@@ -122,7 +122,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   po::options_description physics("Physics");
   char stiffness_help[96];
   std::snprintf(stiffness_help, sizeof stiffness_help,
-                "contact spring constant k, N/m, at least %.1f (softer piles sink through the floor)",
+                "contact spring constant k, N/m, %.1f to 1e9 (softer piles sink through the floor)",
                 double(softest_stiffness(defaults)));
   physics.add_options()("stiffness", po::value(&o.physics.stiffness)->default_value(defaults.stiffness, "25000"),
                         stiffness_help)("restitution",
@@ -198,6 +198,10 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   o.record.every = static_cast<std::uint32_t>(record_every);
   if (!std::isfinite(o.record.from) || o.record.from < 0.0 || o.record.from > 1e9)
     return fail("--record-from must be between 0 and 1e9 simulated seconds, got " + number_text(o.record.from));
+  // An empty name would write nothing without a word.
+  for (const char* flag : {"dump", "record", "export-lammps"})
+    if (vm.count(flag) && vm[flag].as<std::string>().empty())
+      return fail(std::string("--") + flag + " needs a name, got an empty one");
   if (o.record.path.empty())
     for (const char* flag : {"record-every", "record-from", "record-constant-count"})
       if (!vm[flag].defaulted())

@@ -46,8 +46,11 @@ float derived_dt(const PhysicsParams& p) {
 
 std::string validate(const PhysicsParams& p) {
   std::ostringstream err;
+  // The range stated is this gravity's and tank's (the softest check below), where those are valid numbers.
+  const float softest =
+      std::isfinite(softest_stiffness(p)) ? std::max(kSoftestStiffness, softest_stiffness(p)) : kSoftestStiffness;
   if (!std::isfinite(p.stiffness) || p.stiffness < kSoftestStiffness || p.stiffness > 1.0e9f)
-    err << "stiffness k must be in [" << kSoftestStiffness << ", 1e9] N/m, got " << p.stiffness;
+    err << "stiffness k must be in [" << softest << ", 1e9] N/m, got " << p.stiffness;
   else if (!std::isfinite(p.restitution) || p.restitution <= 0.0f || p.restitution > 1.0f)
     err << "restitution e must be in (0, 1], got " << p.restitution;
   else if (!std::isfinite(p.tolerance) || p.tolerance < PhysicsParams::kTightestTolerance ||

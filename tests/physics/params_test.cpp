@@ -57,6 +57,10 @@ TEST_CASE("unstable or absurd parameters are refused with a reason", "[params]")
     p.stiffness = 0.5f;
     CHECK(validate(p).find("stiffness k must be in [1, 1e9]") != std::string::npos);
   }
+  SECTION("stiffness below 1 N/m under gravity: the range stated is gravity's") {
+    p.stiffness = 0.5f;
+    CHECK(validate(p).find("stiffness k must be in [784.8, 1e9]") != std::string::npos);
+  }
   SECTION("stiffness NaN") {
     p.stiffness = std::numeric_limits<float>::quiet_NaN();
     CHECK(validate(p).find("stiffness") != std::string::npos);
