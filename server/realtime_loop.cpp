@@ -27,23 +27,29 @@ double seconds_between(Clock::time_point from, Clock::time_point to) {
 // Its times are when steps fell due (the loop's sim_clock), not when they ran: a window
 // ended between steps far apart, or at a step woken late, would count a step short and
 // read as slow motion. Only time dropped while behind lowers the time scale.
+// The simulated seconds people asked for are summed too (none while paused), so that a
+// window in which they paused, resumed or set another time scale is not read as slow motion.
 struct RateWindow {
   double start;
   double length;
   std::uint64_t steps = 0;
   double busy = 0.0;
+  double asked = 0.0;  // simulated seconds the time scale set asked for
 
-  void add(std::uint64_t batch_steps, double batch_busy) {
+  void add(std::uint64_t batch_steps, double batch_busy, double asked_seconds) {
     steps += batch_steps;
     busy += batch_busy;
+    asked += asked_seconds;
   }
-  // Whether it has ended at `end`; then its rates are written into status and it starts again.
-  bool close(double end, double dt, LoopStatus& status) {
+  // Whether it has ended at `end`; then its rates are written into status and it starts again. The time
+  // scale is the share of the asked time achieved, times the scale asked now (scale_now): where the scale
+  // asked did not change, simulated seconds per wall second.
+  bool close(double end, double dt, double scale_now, LoopStatus& status) {
     const double span = end - start;
     if (span < length) return false;
     status.steps_per_s = steps / span;
     status.load = busy / span;
-    status.time_scale = steps * dt / span;
+    status.time_scale = asked > 0.0 && scale_now > 0.0 ? steps * dt / asked * scale_now : steps * dt / span;
     *this = {end, length};
     return true;
   }
@@ -91,6 +97,7 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
     const double now = seconds_between(start, Clock::now());
     if (options.duration > 0.0 && now >= options.duration) break;
     const Clock::time_point busy_start = Clock::now();
+    const double clock_before = sim_clock;
     if (options.at_step_boundary) options.at_step_boundary(world, status);
     // A step is due every dt / time_scale of wall time; a paused world owes none.
     const double wall_per_step = dt / control.time_scale;
@@ -121,13 +128,16 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
     }
     const Clock::time_point busy_end = Clock::now();
     const double busy = seconds_between(busy_start, busy_end);
-    live.add(batch_steps, busy);
-    line.add(batch_steps, busy);
+    // The wall time this round covered, at the scale asked in it (set by at_step_boundary, before the batch).
+    const double scale_asked = control.paused ? 0.0 : control.time_scale;
+    const double asked = (sim_clock - clock_before) * scale_asked;
+    live.add(batch_steps, busy, asked);
+    line.add(batch_steps, busy, asked);
     status.threads = stepper.threads();
     status.crowding_cores = stepper.crowding_cores();
-    live.close(sim_clock, dt, status);
+    live.close(sim_clock, dt, scale_asked, status);
     LoopStatus line_status = status;
-    if (line.close(sim_clock, dt, line_status)) {
+    if (line.close(sim_clock, dt, scale_asked, line_status)) {
       if (options.on_status) options.on_status(world, line_status);
       status.dropped_steps = 0;
     }

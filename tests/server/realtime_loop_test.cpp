@@ -193,3 +193,41 @@ TEST_CASE("a batch ends at every multiple of boundary_every, running and paused,
     CHECK(std::find(boundaries.begin(), boundaries.end(), step) != boundaries.end());
   }
 }
+
+TEST_CASE("a window in which people resumed or set another time scale is not read as slow motion", "[server][loop]") {
+  World world(with_stiffness(25000.0f), kSseKernels, 1, 5);
+  place_lattice(world, 100);
+  RunControl control;
+  control.paused = true;
+  LoopOptions options;
+  options.control = &control;
+  options.duration = 1.6;
+  options.status_interval = 0.25;
+  const auto start = std::chrono::steady_clock::now();
+  auto since_start = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  options.at_step_boundary = [&](World&, const LoopStatus&) {
+    const double t = since_start();
+    control.paused = t < 0.4;                  // paused, then resumed at half the clock
+    control.time_scale = t < 0.9 ? 0.5 : 1.0;  // then back to real time
+  };
+  struct Line {
+    double at, time_scale, asked;
+  };
+  std::vector<Line> lines;
+  options.on_status = [&](const World&, const LoopStatus& s) {
+    lines.push_back({since_start(), s.time_scale, control.paused ? 0.0 : control.time_scale});
+  };
+  const std::atomic<bool> stop{false};
+  TunedStepper stepper(world, false);
+  run_realtime(stepper, options, stop);
+  REQUIRE(lines.size() >= 5);
+  int running = 0;
+  for (const Line& l : lines) {
+    if (l.asked == 0.0) continue;  // paused
+    ++running;
+    INFO("line at " << l.at << " s: time scale " << l.time_scale << " with " << l.asked << " asked");
+    CHECK_FALSE(slow_motion(l.time_scale, l.asked));
+    CHECK(l.time_scale == Approx(l.asked).margin(0.05));
+  }
+  CHECK(running >= 4);
+}
