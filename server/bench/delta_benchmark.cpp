@@ -165,7 +165,7 @@ int main(int argc, char** argv) {
   }
   benchmark::Initialize(&argc, argv, print_help);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
+  const bool ran = benchmark::RunSpecifiedBenchmarks() > 0;  // a filter that matches nothing fails
   benchmark::Shutdown();
-  return 0;
+  return ran ? 0 : 1;
 }
