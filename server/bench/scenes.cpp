@@ -24,7 +24,7 @@ SettleReport settle(TunedStepper& stepper, const SceneSpec& spec) {
     const double sim = done * double(world.dt());
     const double energy = world.ball_count() ? kinetic_energy(world) / world.ball_count() : 0.0;
     if (done / check_every % kChecksPerReport == 0)
-      std::fprintf(stderr, "settling: %.0f s simulated, %u balls in, %u queued, kinetic energy %.2g J/ball\n", sim,
+      std::fprintf(stderr, "settling: %.1f s simulated, %u balls in, %u queued, kinetic energy %.2g J/ball\n", sim,
                    world.ball_count(), world.pending(), energy);
     report.settled = world.pending() == 0 && energy < kRestEnergy;
     if (report.settled || sim >= limit) {
