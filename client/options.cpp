@@ -115,8 +115,10 @@ ClientParse parse_client_options(int argc, const char* const argv[]) {
     return fail("--for must be seconds >= 0, got " + number_text(o.script.move_for));
   if (!std::isfinite(o.script.duration) || o.script.duration <= 0.0 || o.script.duration > 86400.0)
     return fail("--duration must be more than 0 and at most 86400 seconds, got " + number_text(o.script.duration));
-  if (!std::isfinite(o.script.every) || o.script.every < 0.0)
-    return fail("--every must be seconds >= 0, got " + number_text(o.script.every));
+  if (!std::isfinite(o.script.every) || o.script.every < 0.0 ||
+      (o.script.every > 0.0 && o.script.every < kShortestEvery))
+    return fail("--every must be 0 (no interval reports) or at least " + number_text(kShortestEvery) +
+                " s, the client's tick, got " + number_text(o.script.every));
   if (!std::isfinite(read_rate_kb) || read_rate_kb < 0.0 || (read_rate_kb > 0.0 && read_rate_kb < 1.0))
     return fail("--read-rate must be 0 (no limit) or at least 1 kB a second, got " + number_text(read_rate_kb));
   if (pause && resume) return fail("--pause and --resume contradict each other; give one");

@@ -18,7 +18,7 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-constexpr auto kTick = std::chrono::milliseconds(50);
+const auto kTick = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kShortestEvery));
 constexpr int kTicksPerPing = 5;
 // While connections are still to open: how often to look whether one more may wait for its Welcome.
 constexpr auto kRampTick = std::chrono::milliseconds(1);

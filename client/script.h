@@ -16,6 +16,9 @@
 
 namespace fishtank::client {
 
+// The client looks at its connections (and reports an interval) this often.
+inline constexpr double kShortestEvery = 0.05;
+
 struct Script {
   std::string host = "127.0.0.1";
   std::uint16_t port = 7878;
@@ -36,7 +39,7 @@ struct Script {
   std::optional<float> time_scale;
   std::optional<bool> pause;  // true: Pause, false: resume
   std::uint32_t step = 0;     // steps to run while paused
-  double every = 0.0;         // seconds between interval reports; 0: none
+  double every = 0.0;         // seconds between interval reports, at least kShortestEvery; 0: none
 };
 
 // What every connection received in one --every interval, summed.
