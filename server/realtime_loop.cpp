@@ -57,7 +57,7 @@ struct RateWindow {
 }  // namespace
 
 TunedStepper::TunedStepper(World& world, bool tune) : world_(world), epoch_(Clock::now()) {
-  if (!tune) return;
+  if (!tune || world.threads() == 1) return;  // one thread has nothing to choose, nor other sessions to blame
   tuner_.emplace(world.threads());
   world.set_thread_limit(tuner_->threads());
 }

@@ -64,7 +64,7 @@ nlohmann::json time_steps(TunedStepper& stepper, const BenchSpec& spec, const Se
   j["one_thread_step_fraction"] =
       double(stepper.steps_on_one_thread() - one_thread_before) / std::max<std::uint64_t>(1, spec.steps);
   // Cores work in other sessions kept busy at the end (MachineLoad), which keeps the steps on one thread;
-  // null untuned.
+  // null untuned (--fixed-threads, or one thread).
   if (const double crowding = stepper.crowding_cores(); crowding >= 0.0)
     j["crowding_cores"] = crowding;
   else
