@@ -88,6 +88,11 @@ void WebSession::on_request() {
     return respond_text(http::status::not_found, "<p>404: WebSocket connections upgrade at /ws only.</p>\n",
                         request.keep_alive());
   }
+  if (path && *path == "/ws")  // someone opened the socket's address in a browser, or fetched it with curl
+    return respond_text(http::status::upgrade_required,
+                        "<p>426: /ws is the viewer's WebSocket, which a browser opens from the page; open / instead."
+                        "</p>\n",
+                        request.keep_alive());
   if (request.method() != http::verb::get && request.method() != http::verb::head) {
     http::response<http::string_body> response{http::status::method_not_allowed, request.version()};
     response.set(http::field::allow, "GET, HEAD");

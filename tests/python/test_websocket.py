@@ -207,7 +207,8 @@ def test_files_are_served_from_the_web_root_and_nothing_outside_it(start_server,
         assert b"not for the web" not in body
 
 
-def test_other_methods_get_405_upgrades_elsewhere_404_and_an_over_size_header_431(start_server, web_root):
+def test_other_methods_get_405_upgrades_elsewhere_404_ws_without_upgrade_426_and_an_over_size_header_431(
+        start_server, web_root):
     server = start_server("--balls", "0", "--web-port", "0", "--web-root", str(web_root))
     port = server.web_port
     for method in ("POST", "PUT", "DELETE", "OPTIONS"):
@@ -217,6 +218,8 @@ def test_other_methods_get_405_upgrades_elsewhere_404_and_an_over_size_header_43
                "Sec-WebSocket-Key": "dGhlIHNhbXBsZSBub25jZQ=="}
     assert _request(port, "GET", "/index.html", upgrade)[0] == 404
     assert _request(port, "GET", "/ws", {"X-Filler": "a" * 20000})[0] == 431
+    status, _, body = _request(port, "GET", "/ws")  # the socket's address opened in a browser
+    assert status == 426 and b"open / instead" in body
 
 
 def test_without_a_built_page_the_server_says_how_to_build_it_and_ws_still_works(start_server, tmp_path):
