@@ -39,9 +39,9 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   std::int64_t windows = o.bench_spec.windows;
 
   // The default names what it follows, not this machine's count, so the flag tables can state it.
-  const std::string threads_help = threaded ? "worker threads at most (" + std::to_string(threads) +
+  const std::string threads_help = threaded ? "worker threads at most, 1 to 1024 (" + std::to_string(threads) +
                                                   " here); the server steps on one instead while that measures "
-                                                  "faster (a busy machine)"
+                                                  "faster (a busy machine) or for under 2048 balls"
                                             : "worker threads (the scalar build uses 1)";
   po::options_description general("General");
   general.add_options()("help,h", "print this help and exit")(
@@ -55,7 +55,8 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "scene holds where that is fewer)")("max-balls", po::value(&max_balls)->default_value(0),
                                           "most balls the tank may hold (0: its capacity, ~6100; more is refused)")(
       "duration", po::value(&o.duration)->default_value(0.0), "stop after this many seconds (0: run until Ctrl-C)")(
-      "status-interval", po::value(&o.status_interval)->default_value(1.0), "seconds between status lines");
+      "status-interval", po::value(&o.status_interval)->default_value(1.0),
+      "seconds between status lines, 0.05 to 3600");
 
   std::int64_t lammps_steps = static_cast<std::int64_t>(o.lammps_steps), record_every = o.record.every;
   po::options_description output("Output (written when the server stops, or after --bench)");
