@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 ase_io = pytest.importorskip("ase.io")
+ase_units = pytest.importorskip("ase.units")
 mda = pytest.importorskip("MDAnalysis")
 
 TANK_LO = np.array([-20.0, 0.0, -20.0])  # the tank scene's box: x and z in [-20, 20], y in [0, 40]
@@ -68,6 +69,12 @@ def test_a_pour_recorded_from_t0_opens_in_ase_frame_by_frame_and_ends_at_the_dum
     last = images[-1]
     assert np.allclose(last.positions, final[:, :3], rtol=5e-7, atol=0.0)
     assert np.array_equal(last.numbers, final[:, 6].astype(int))
+    # The manual's recipe for masses and kinetic energy gives --dump's (ASE would take H, He and Li's).
+    v = last.get_velocities() * 1000 * ase_units.fs  # first: ASE keeps momenta, which new masses would rescale
+    last.set_masses(last.numbers)
+    assert np.array_equal(last.get_masses(), final[:, 7])
+    assert 0.5 * (last.get_masses()[:, None] * v**2).sum() == pytest.approx(
+        0.5 * (final[:, 7:8] * final[:, 3:6]**2).sum(), rel=1e-5)
     assert np.all(last.positions[:, 1] > 0.0) and np.all(last.positions[:, 1] < 40.0)
 
 
