@@ -252,7 +252,8 @@ Frame encode_welcome(const WelcomeInfo& info) {
   return finish(
       b, wire::CreateWelcome(b, kProtocolVersion, info.client_id, variant, simd, info.worker_threads, &tank_min,
                              &tank_max, info.dt, kinds_offset, info.player_id.has_value(), info.player_id.value_or(0),
-                             info.snapshot_rate_hz, policy, info.may_control, info.steps_per_contact, info.tolerance));
+                             info.snapshot_rate_hz, policy, info.may_control, info.steps_per_contact, info.tolerance,
+                             info.observers_may_control));
 }
 
 Frame encode_ball_kinds(std::uint32_t first_new_ball, const std::uint8_t* kinds, std::size_t count) {

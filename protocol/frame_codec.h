@@ -84,6 +84,7 @@ struct WelcomeInfo {
   bool may_control = false;        // whether this client may
   float steps_per_contact = 0.0f;  // contact duration of the lightest pair / dt
   float tolerance = 0.0f;          // the per-collision error dt was chosen for; 0: dt given
+  bool observers_may_control = false;  // whether a client without a player sphere may
 };
 Frame encode_welcome(const WelcomeInfo& info);
 

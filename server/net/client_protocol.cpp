@@ -270,6 +270,7 @@ Outcome ClientProtocol::on_reply(const Reply& reply) {
     has_player_ = joined->player_id.has_value();
     w.control_policy = describe(info_.control);
     w.may_control = may_control(info_.control, has_player_);
+    w.observers_may_control = may_control(info_.control, false);
     out.replies.push_back(protocol::encode_welcome(w));
     last_move_ = Clock::now();
     if (!joined->refusal.empty())

@@ -47,6 +47,7 @@ TEST_CASE("every message survives encode then decode with its values intact", "[
     w.may_control = true;
     w.steps_per_contact = 13.0f;
     w.tolerance = 0.005f;
+    w.observers_may_control = true;
     const protocol::Frame f = protocol::encode_welcome(w);
     const auto r = decode(f, Direction::to_client);
     REQUIRE(r.ok());
@@ -62,6 +63,7 @@ TEST_CASE("every message survives encode then decode with its values intact", "[
     CHECK(m.may_control());
     CHECK(m.steps_per_contact() == 13.0f);
     CHECK(m.tolerance() == 0.005f);
+    CHECK(m.observers_may_control());
   }
   SECTION("Snapshot") {
     const std::vector<std::uint16_t> q{1, 2, 3, 65535, 0, 7};
