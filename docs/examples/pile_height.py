@@ -3,13 +3,13 @@
 
     PYTHONPATH=build/python python3 docs/examples/pile_height.py --port 7878 --out pile_height.png
 
-The tank scene is started again (everyone connected sees it), balls pour in
-from the top, and four times a second the pile's height is measured: the height
-below which the tops of 99 % of the balls at rest lie (a ball at rest moved
-less than 2 cm in a tenth of a second), so balls still falling, and the odd
-one at the top of its bounce, do not count. A ball's radius comes from its
-kind (Client.kinds). The plot shows the height and the balls in the tank
-against simulated time since the restart.
+The tank scene is started again (everyone connected sees it) and resumed if
+another client left it paused, balls pour in from the top, and four times a
+second the pile's height is measured: the height below which the tops of 99 %
+of the balls at rest lie (a ball at rest moved less than 2 cm in a tenth of a
+second), so balls still falling, and the odd one at the top of its bounce, do
+not count. A ball's radius comes from its kind (Client.kinds). The plot shows
+the height and the balls in the tank against simulated time since the restart.
 """
 
 import argparse
@@ -99,6 +99,9 @@ def main():
     with Client(args.host, args.port) as tank:
         radii = np.array([diameter / 2 for diameter, _ in tank.kinds], dtype=np.float32)
         start = tank.scene("tank", seed=args.seed)
+        if start.paused:  # left so by another client: no ball would pour in, and the pile would stay at 0 m
+            print("pile_height.py: the simulation was paused; resuming it to measure", file=sys.stderr)
+            tank.resume()
         if args.add:
             tank.add_balls(args.add)
         times, heights, counts = [], [], []

@@ -11,13 +11,13 @@ server paces it by what its link carries, as it does a viewer, and a program
 may take as long as it likes between calls: snapshot() returns the newest.
 """
 
-import math
 import numbers
 import re
 import socket
 import struct
 import threading
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import flatbuffers
@@ -34,6 +34,10 @@ _QUANT_STEPS = np.float32(65535.0)  # protocol/quantize.h: kQuantSteps
 _ERROR_NAMES = {value: name for name, value in vars(ErrorCode.ErrorCode).items() if not name.startswith("_")}
 _UINT32_MAX = 2**32 - 1  # AddBalls.count, Step.count
 _UINT64_MAX = 2**64 - 1  # Reset.seed
+_MAX_NAME_BYTES = 64  # protocol/frame_codec.h: kMaxClientNameBytes; the server refuses a longer Hello
+_MIN_TIME_SCALE = np.float32(0.1)  # protocol/frame_codec.h: kMinTimeScale .. kMaxTimeScale
+_MAX_TIME_SCALE = np.float32(1.0)
+_MAX_SECONDS = threading.TIMEOUT_MAX  # the longest wait Python's locks and sockets take
 _SCENES = "tank, wide, dam-break or drop"
 # "host:port" or "[v6]:port" in one string; an unbracketed IPv6 literal ("::1") has more than one colon.
 _HOST_WITH_PORT = re.compile(r"\[([^\]]+)\]:(\d+)|([^:\[\]]+):(\d+)")
@@ -85,6 +89,64 @@ def _whole_number(value, what, lowest, highest):
     return int(value)
 
 
+def _seconds(value, what):
+    """value as float seconds, or ValueError naming what: True would pass for one second, and a wait beyond
+    _MAX_SECONDS (infinity too) fails in the lock's or socket's words (OverflowError)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0 < value <= _MAX_SECONDS:
+        raise ValueError(f"{what} must be a positive number of seconds, at most {_MAX_SECONDS:.0f}, got {value!r}")
+    return float(value)
+
+
+def _float32s(values):
+    """values as floats, or None where one of them does not fit a float32 (the wire's floats)."""
+    try:
+        floats = [float(v) for v in values]
+    except OverflowError:  # an int beyond any float
+        return None
+    with np.errstate(over="ignore"):
+        return floats if np.all(np.isfinite(np.array(floats, dtype=np.float32))) else None
+
+
+def _velocity(velocity):
+    """velocity as three floats, or ValueError: a string or a mapping would pass as its characters or keys, and
+    FlatBuffers would refuse a value beyond float32 as OverflowError."""
+    three = velocity.shape == (3,) if isinstance(velocity, np.ndarray) else (
+        isinstance(velocity, Sequence) and not isinstance(velocity, (str, bytes, bytearray)) and len(velocity) == 3)
+    if not three or not all(isinstance(c, numbers.Real) and not isinstance(c, bool) for c in velocity):
+        raise ValueError("velocity must be three numbers (x, y, z) in m/s, as a tuple, list or numpy array, got "
+                         f"{velocity!r}")
+    floats = _float32s(velocity)
+    if floats is None:
+        raise ValueError(f"velocity must be finite, within a float32's range (3.4e38), got {velocity!r}")
+    return floats
+
+
+def _time_scale(scale):
+    """scale as the float32 the server receives, checked as the server checks it (frame_codec.cpp): a value
+    that rounds into the range is taken, 1.0000001 (a float32 above 1) is not."""
+    if not isinstance(scale, bool) and isinstance(scale, numbers.Real) and (floats := _float32s([scale])):
+        wire = np.float32(floats[0])
+        if _MIN_TIME_SCALE <= wire <= _MAX_TIME_SCALE:
+            return float(wire)
+    raise ValueError("time_scale's scale must be a number from 0.1 to 1 (simulated seconds per wall second), "
+                     f"got {scale!r}")
+
+
+def _client_name(name):
+    """name, or ValueError: FlatBuffers would refuse a non-string after the socket is open, and the server a
+    longer one, closing the connection."""
+    if not isinstance(name, str):
+        raise ValueError(f"name must be a string of at most {_MAX_NAME_BYTES} bytes in UTF-8, got {name!r}")
+    try:
+        size = len(name.encode())
+    except UnicodeEncodeError:
+        raise ValueError(f"name must be text UTF-8 can encode, got {name!r}") from None
+    if size > _MAX_NAME_BYTES:
+        raise ValueError(f"name must be at most {_MAX_NAME_BYTES} bytes in UTF-8 (the server's limit), got {size} "
+                         f"bytes: {name[:20]!r}...")
+    return name
+
+
 def _server_command(host, port):
     """The command that starts a server answering at host:port: it listens on 127.0.0.1 unless given --bind
     (common/server_hint.h says the same for the viewer)."""
@@ -134,19 +196,21 @@ class Client:
     def __init__(self, host="127.0.0.1", port=7878, player=True, name="fishtank-python", timeout=10.0):
         # Checked here: the socket layer would wrap 70000 to another port, or fail in its own words.
         port = _whole_number(port, "port", 1, 65535)
-        if not (isinstance(timeout, (int, float)) and timeout > 0):
-            raise ValueError(f"timeout must be a positive number of seconds, got {timeout!r}")
-        self.timeout = timeout
+        self.timeout = _seconds(timeout, "timeout")
+        name = _client_name(name)
+        # None would connect to this machine, bytes would be written as "b'...'" in every message.
+        if not isinstance(host, str) or not host:
+            raise ValueError(f'host must be a host name or an address as a string, e.g. "127.0.0.1", got {host!r}')
         # "[::1]" as the server's listening line and --connect write an IPv6 address; the socket wants "::1".
-        if isinstance(host, str) and len(host) > 2 and host[0] == "[" and host[-1] == "]":
+        if len(host) > 2 and host[0] == "[" and host[-1] == "]":
             host = host[1:-1]
         # Refused before any look-up, which would only say the name does not resolve.
-        if isinstance(host, str) and (joined := _HOST_WITH_PORT.fullmatch(host)):
+        if joined := _HOST_WITH_PORT.fullmatch(host):
             alone, digits = (joined[1], joined[2]) if joined[1] else (joined[3], joined[4])
             raise FishtankError("cannot_connect", f"{host} is a host and a port in one string; give the port as "
                                 f'the second argument: Client("{alone}", {int(digits)})')
         self._wants_player = bool(player)
-        self.address = f"[{host}]:{port}" if ":" in str(host) else f"{host}:{port}"
+        self.address = f"[{host}]:{port}" if ":" in host else f"{host}:{port}"
         self._sock = self._connect(host, port)
         self._sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         # What the reader thread writes, the caller reads under this; it is notified of every frame.
@@ -192,28 +256,36 @@ class Client:
         a sphere another client frees comes to it, first in line. Raises FishtankError "no_player" where it is
         not in line (it asked for none, or the server has none) and "timeout" where none came in time (default:
         the client's timeout)."""
+        seconds = self.timeout if timeout is None else _seconds(timeout, "wait_for_player's timeout")
+
         def holds():
             # The refusal and the place in line come before any snapshot, so a snapshot without them means no line.
             if self.player_id is None and self.ahead_in_line is None and self._last is not None:
                 raise FishtankError("no_player", self._not_in_line_text())
             return self.player_id is not None
 
-        self._wait(holds, time.monotonic() + (self.timeout if timeout is None else timeout))
+        def no_sphere_came():
+            if self.ahead_in_line is None:  # no word of the line yet: the server did not answer
+                return self._timed_out()
+            place = "next in line" if self.ahead_in_line == 0 else f"in line, {self.ahead_in_line} before it"
+            return FishtankError("timeout", f"no player sphere came to this client within {seconds:g} s: it is "
+                                 f"{place}, and no sphere was freed (one is when its client leaves, or leaves it "
+                                 "unmoved for the server's --player-idle); give wait_for_player(timeout=) more "
+                                 "seconds")
+
+        self._wait(holds, time.monotonic() + seconds, no_sphere_came)
         return self.player_id
 
     def move(self, velocity):
         """Sets the player sphere's velocity (metres per second, x y z); it keeps it until the next move()."""
         self._check_open()  # before the sphere: a closed client says it is closed
         if self.player_id is None:  # the reader takes a sphere freed by another (PlayerGranted) as it comes
-            raise FishtankError("no_player", "this client has no player sphere to move")
+            freed = next((e for e in reversed(self.errors) if e.code == "player_idle"), None)
+            raise FishtankError("no_player",
+                                "this client has no player sphere to move" + (f" ({freed})" if freed else ""))
         # Checked here, not refused by the server later: move() does not wait, so a refusal would be raised
         # by whichever call came next.
-        try:
-            x, y, z = (float(c) for c in velocity)
-        except (TypeError, ValueError):
-            raise ValueError(f"velocity must be three numbers (x, y, z) in m/s, got {velocity!r}") from None
-        if not all(math.isfinite(c) for c in (x, y, z)):
-            raise ValueError(f"velocity must be finite, got {velocity!r}")
+        x, y, z = _velocity(velocity)
         self._sequence += 1
 
         def build(b):
@@ -233,19 +305,19 @@ class Client:
 
     def pause(self):
         """Pauses the simulation for everyone and waits until a snapshot shows it."""
-        self._send(_frame(Payload.Payload.Pause, lambda b: self._table(b, Pause, AddPaused=True)))
-        return self._wait_for(lambda s: s.paused)
+        return self._control(_frame(Payload.Payload.Pause, lambda b: self._table(b, Pause, AddPaused=True)),
+                             lambda s: s.paused)
 
     def resume(self):
-        self._send(_frame(Payload.Payload.Pause, lambda b: self._table(b, Pause, AddPaused=False)))
-        return self._wait_for(lambda s: not s.paused)
+        return self._control(_frame(Payload.Payload.Pause, lambda b: self._table(b, Pause, AddPaused=False)),
+                             lambda s: not s.paused)
 
     def step(self, n=1):
         """Runs n steps while paused and returns the snapshot taken once they are done."""
         n = _whole_number(n, "step's n", 1, _UINT32_MAX)
         before = self._current().physics_steps
-        self._send(_frame(Payload.Payload.Step, lambda b: self._table(b, Step, AddCount=n)))
-        return self._wait_for(lambda s: (s.physics_steps - before) % 2**32 >= n)
+        return self._control(_frame(Payload.Payload.Step, lambda b: self._table(b, Step, AddCount=n)),
+                             lambda s: (s.physics_steps - before) % 2**32 >= n)
 
     def reset(self, seed=None):
         """Starts the running scene again (with this seed, or the scene's last) and returns its first snapshot."""
@@ -260,10 +332,11 @@ class Client:
         return self._restart(name, seed)
 
     def time_scale(self, scale):
-        """Asks for simulated seconds per wall second, 0.1 .. 1 (the server refuses other values)."""
-        scale = float(np.float32(scale))
-        self._send(_frame(Payload.Payload.SetTimeScale, lambda b: self._table(b, SetTimeScale, AddScale=scale)))
-        return self._wait_for(lambda s: s.time_scale_set == scale)
+        """Asks for simulated seconds per wall second, 0.1 .. 1, and waits until a snapshot shows it asked for."""
+        scale = _time_scale(scale)
+        return self._control(_frame(Payload.Payload.SetTimeScale,
+                                    lambda b: self._table(b, SetTimeScale, AddScale=scale)),
+                             lambda s: s.time_scale_set == scale)
 
     def close(self):
         self._closing = True
@@ -331,8 +404,15 @@ class Client:
                 Reset.AddSeed(b, seed)
             return Reset.End(b)
 
-        self._send(_frame(Payload.Payload.Reset, build))
-        return self._wait_for(lambda s: s.scene_start != before)
+        return self._control(_frame(Payload.Payload.Reset, build), lambda s: s.scene_start != before)
+
+    def _control(self, frame, done):
+        """Sends a control and returns the first snapshot after it that satisfies done. Its refusal is raised
+        here, not by a later call: the round trip waits for it where done holds without the control (a resume
+        while running, a step's count run by a running simulation)."""
+        self._send(frame)
+        self._round_trip()
+        return self._wait_for(done)
 
     def _send(self, frame):
         """Sends for the caller: a connection that has ended raises why it ended (the server's last Error), not
@@ -358,9 +438,9 @@ class Client:
 
     # ---- receiving: the caller's side ----
 
-    def _wait(self, ready, deadline):
+    def _wait(self, ready, deadline, timed_out=None):
         """Waits until ready() (called under the lock) returns something true, and returns that; raises why the
-        connection ended, or FishtankError "timeout" at the deadline."""
+        connection ended, or at the deadline timed_out() (under the lock), by default FishtankError "timeout"."""
         with self._changed:
             while True:
                 self._check_open()  # what arrived before close() is not an answer to a later call
@@ -370,7 +450,7 @@ class Client:
                     return value
                 left = deadline - time.monotonic()
                 if left <= 0:
-                    raise self._timed_out()
+                    raise (timed_out or self._timed_out)()
                 self._changed.wait(left)
 
     def _take_newest(self):
@@ -378,7 +458,9 @@ class Client:
         return s
 
     def _raise_refusal(self):
-        """Raises the oldest refusal not raised yet, forgetting any after it (under the lock)."""
+        """Raises the oldest refusal not raised yet, forgetting any after it (under the lock): each call waits for
+        the refusals of what it sent, so those after it answered the same call (an AddBalls' rate_limited, then
+        its tank_full); all are in errors."""
         if self._unraised:
             error = self._unraised[0]
             self._unraised.clear()
@@ -408,8 +490,10 @@ class Client:
         self._send(_frame(Payload.Payload.Ping, lambda b: self._table(b, Ping, AddClientTimeUs=stamp)))
         deadline = time.monotonic() + self.timeout
         _, before = self._wait(lambda: self._pong if self._pong and self._pong[0] == stamp else None, deadline)
-        # A physics-thread answer (AddBalls' tank_full) goes out before the first snapshot published after
-        # the command was applied; the second snapshot after the Pong is surely later than that.
+        # A physics-thread answer (AddBalls' tank_full, Step's not_paused, Reset's superseded) is posted to the
+        # session before any snapshot published after the command was applied (physics_link.cpp), and a session
+        # writes its replies before its snapshot (session.cpp). The second snapshot after the Pong was offered
+        # after the first went out, after the Pong: surely later than that.
         self._wait(lambda: self._received >= before + 2, deadline)
         with self._changed:
             self._take_newest()
@@ -442,7 +526,7 @@ class Client:
                     self._let_go()
                     raise ConnectionError("the server closed the connection" + self._last_error_text())
                 buffer += chunk
-                while (frame := self._split_frame(buffer)) is not None:
+                while (frame := self._next_frame(buffer)) is not None:
                     tick = self._handle(Message.Message.GetRootAs(frame, 4))
                     if tick is not None:
                         self._acknowledge(tick)
@@ -490,6 +574,18 @@ class Client:
         reason = next((e for e in reversed(self.errors) if e.code in ("player_limit", "player_idle")), None)
         return "this client is not in line for a player sphere" + (f" ({reason})" if reason else "")
 
+    def _next_frame(self, buffer):
+        """_split_frame, where a peer that answers the Hello with no Fishtank frame is not a server to talk to."""
+        try:
+            return self._split_frame(buffer)
+        except ConnectionError:
+            if self.welcome is not None:  # a fault after the handshake: the connection ended, not the wrong peer
+                raise
+            said = bytes(buffer[:48]).splitlines()[0] if buffer else b""
+            raise FishtankError("cannot_connect", f"the peer at {self.address} does not speak Fishtank's protocol "
+                                f"(it sent {repr(said)[1:]}); check the port: the server's 'listening on' line "
+                                "shows it") from None
+
     @staticmethod
     def _split_frame(buffer):
         """Takes one complete frame off the front of the buffer; None when none is complete."""
@@ -501,9 +597,9 @@ class Client:
         if len(buffer) < 4 + length:
             return None
         frame = bytes(buffer[: 4 + length])
-        del buffer[: 4 + length]
-        if frame[8:12] != _IDENTIFIER:
+        if frame[8:12] != _IDENTIFIER:  # left in the buffer: what the peer sent tells what it is
             raise ConnectionError("not a Fishtank frame (file identifier is not FTNK)")
+        del buffer[: 4 + length]
         return frame
 
     def _handle(self, m):
@@ -543,9 +639,11 @@ class Client:
                     raise error
                 if error.code == "player_idle":  # the sphere was freed; the client observes
                     self.player_id = None
-                # player_limit: the Welcome says so too, this client observes, in line. server_stopping refuses
-                # nothing asked: the ConnectionError of every later call carries it.
-                if error.code not in ("player_limit", "server_stopping"):
+                    self.may_control = self.welcome.ObserversMayControl()
+                # player_limit and player_idle say this client observes (in line, or its sphere freed) and
+                # refuse nothing asked: raised by the next call they would pass for its refusal; move() and
+                # wait_for_player() say them. server_stopping: the ConnectionError of every later call carries it.
+                if error.code not in ("player_limit", "player_idle", "server_stopping"):
                     self._unraised.append(error)
             elif kind == Payload.Payload.PlayerGranted:
                 g = PlayerGranted.PlayerGranted()

@@ -5,6 +5,7 @@ bit, a time scale of one half halves the pace); refusals raise FishtankError
 and leave the connection working."""
 
 import os
+import re
 import signal
 import socket
 import stat
@@ -12,6 +13,7 @@ import subprocess
 import sys
 import threading
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -50,6 +52,22 @@ def test_positions_agree_with_the_servers_own_state_within_half_a_quantisation_s
     half_step = 0.5 * (s.tank_max - s.tank_min) / 65535.0
     error = np.abs(s.positions - state[:, :3])
     assert np.all(error <= half_step * 1.01 + 1e-5), error.max(axis=0)
+
+
+def test_the_documented_bound_on_positions_holds_for_the_worst_rounding_in_the_40_m_tank():
+    """Quantised as the server does (protocol/quantize.h, in float32) and dequantised by the client, positions
+    just either side of the midpoints between two quanta: half a step, plus float32 rounding."""
+    docs = (Path(__file__).resolve().parents[2] / "docs" / "python-client.md").read_text()
+    bound = float(re.search(r"within\s+([0-9.]+)\s+m\s+of\s+the\s+server's\s+own\s+value", docs)[1])
+    worst = 0.0
+    for lo, hi in ((np.float32(-20), np.float32(20)), (np.float32(0), np.float32(40))):  # x and z, y
+        k = np.arange(65535, dtype=np.float64)
+        v = np.concatenate([lo + (k + 0.5) * ((float(hi) - lo) / 65535) + d for d in (-1e-6, 0, 1e-6)])
+        v = v.astype(np.float32)
+        t = np.clip((v - lo) / (hi - lo), np.float32(0), np.float32(1))
+        q = (t * np.float32(65535) + np.float32(0.5)).astype(np.uint16)
+        worst = max(worst, float(np.max(np.abs(fishtank.client.dequantize(q, lo, hi).astype(np.float64) - v))))
+    assert 40 / 65535 / 2 < worst <= bound, (worst, bound)
 
 
 def test_the_welcome_says_how_dt_was_chosen_from_the_tolerance_or_given(start_server):
@@ -137,6 +155,9 @@ def test_a_client_in_line_for_a_sphere_gets_the_one_its_holder_frees_and_can_mov
         with pytest.raises(FishtankError) as not_yet:
             waiting.wait_for_player(timeout=0.5)  # the holder has not left
         assert not_yet.value.code == "timeout"
+        # The server answered (the client is in line): no sphere was freed in the time asked for.
+        assert not_yet.value.message.startswith("no player sphere came to this client within 0.5 s: it is next in "
+                                                "line, and no sphere was freed"), not_yet.value.message
         holder.close()
         granted = waiting.wait_for_player()
         assert granted is not None and granted == waiting.player_id
@@ -164,6 +185,29 @@ def test_waiting_for_a_sphere_outside_the_line_says_so_at_once(start_server):
         assert "--max-players 0" in str(refused.errors[0])
 
 
+def test_a_sphere_freed_for_idleness_takes_control_as_the_servers_policy_does_and_raises_nothing_itself(
+        start_server):
+    for policy, may in (("players", False), ("everyone", True)):
+        server = start_server("--balls", "10", "--player-idle", "0.5", "--control", policy)
+        with Client("127.0.0.1", server.port) as idle:
+            assert idle.may_control
+            deadline = time.monotonic() + 10
+            while idle.player_id is not None and time.monotonic() < deadline:
+                idle.snapshot()
+            assert idle.player_id is None and [e.code for e in idle.errors] == ["player_idle"]
+            assert idle.may_control is may, policy
+            if may:
+                assert idle.pause().paused  # the server lets it: player_idle is not raised in its place
+            else:
+                with pytest.raises(FishtankError) as refused:
+                    idle.pause()
+                assert refused.value.code == "not_permitted"  # the server's answer, not the player_idle before it
+            with pytest.raises(FishtankError) as none:
+                idle.move((1, 0, 0))
+            assert none.value.code == "no_player" and "(player_idle: your player sphere did not move" in \
+                none.value.message
+
+
 def test_refusals_raise_with_the_servers_reason_and_the_connection_keeps_working(start_server):
     server = start_server("--balls", "50")
     with Client("127.0.0.1", server.port) as tank, Client("127.0.0.1", server.port, player=False) as observer:
@@ -173,14 +217,44 @@ def test_refusals_raise_with_the_servers_reason_and_the_connection_keeps_working
         with pytest.raises(FishtankError) as unknown:
             tank.scene("cube")
         assert unknown.value.code == "invalid_value" and "tank, wide, dam-break and drop" in unknown.value.message
-        with pytest.raises(FishtankError) as fast:
-            tank.time_scale(5)
-        assert fast.value.code == "invalid_value"
+        with pytest.raises(FishtankError) as many:
+            tank.step(100_001)  # the server's limit, not the wire's
+        assert many.value.code == "invalid_value" and "Step.count must be between 1 and 100000" in many.value.message
         assert not observer.may_control and "observers may not" in observer.control_policy
         with pytest.raises(FishtankError) as refused:
             observer.pause()
         assert refused.value.code == "not_permitted"
         assert not tank.snapshot().paused and observer.snapshot().scene == "tank"
+
+
+def test_a_control_refused_where_what_it_asks_for_holds_already_raises_its_own_refusal_not_the_next_call(
+        start_server):
+    server = start_server("--balls", "50")
+    with Client("127.0.0.1", server.port) as tank, Client("127.0.0.1", server.port, player=False) as observer:
+        for call, payload in ((observer.resume, "Pause"), (lambda: observer.time_scale(1), "SetTimeScale"),
+                              (tank.pause, None), (observer.pause, "Pause"), (lambda: observer.step(1), "Step"),
+                              (observer.reset, "Reset"), (tank.resume, None), (observer.resume, "Pause")):
+            if payload is None:  # the player's own control, allowed: it raises nothing left by the observer's
+                call()
+                continue
+            with pytest.raises(FishtankError) as refused:
+                call()
+            assert refused.value.code == "not_permitted" and refused.value.message.startswith(f"{payload} refused")
+        assert [e.code for e in observer.errors] == ["not_permitted"] * 6 and tank.errors == []
+
+
+def test_step_while_running_raises_not_paused_itself_though_a_snapshot_under_way_shows_the_steps_run(start_server):
+    """Over a link slower than the snapshots one is under way when the Step goes out: it shows more steps than
+    asked for, run by the running simulation, and arrives before the refusal."""
+    server = start_server("--scene", "drop", "--balls", "500")
+    link = fishtank_tools.SlowLink(server.port, 100_000)
+    with Client("127.0.0.1", link.port) as tank:
+        tank.snapshot()
+        for _ in range(10):
+            with pytest.raises(FishtankError) as running:
+                tank.step(1)
+            assert running.value.code == "not_paused"
+        assert tank.pause().paused and [e.code for e in tank.errors] == ["not_paused"] * 10
 
 
 def test_a_port_where_nothing_listens_raises_fishtank_error_with_the_address_and_the_server_command():
@@ -220,18 +294,76 @@ def test_a_port_or_timeout_out_of_range_is_refused_before_any_connection_with_th
             Client("127.0.0.1", port)
     with pytest.raises(ValueError, match=r"port must be a whole number from 1 to 65535, got 70000"):
         Client("127.0.0.1", np.int64(70000))
-    for timeout in (0, -1):
-        with pytest.raises(ValueError, match=r"timeout must be a positive number of seconds"):
+    for timeout in (0, -1, float("inf"), 1e300, float("nan"), True, "5", None):
+        with pytest.raises(ValueError) as refused:  # inf and 1e300: OverflowError in the socket's words before
             Client("127.0.0.1", 7878, timeout=timeout)
+        assert str(refused.value) == ("timeout must be a positive number of seconds, at most 9223372036, got "
+                                      f"{timeout!r}")
+    with socket.socket() as probe:  # a port just freed: a timeout that passes the check gets as far as connecting
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    for timeout in (np.float32(5), np.int64(3), 0.5):
+        with pytest.raises(FishtankError, match="connection refused"):
+            Client("127.0.0.1", port, timeout=timeout)
+
+
+def test_a_name_or_host_the_hello_cannot_carry_is_refused_before_connecting_and_a_name_of_64_bytes_is_not(
+        start_server, monkeypatch):
+    server = start_server("--balls", "10")
+    with Client("127.0.0.1", server.port, name="\u00e9" * 32) as longest:  # 64 bytes in UTF-8: the server's limit
+        assert longest.snapshot().scene == "tank"
+    tried = []
+    monkeypatch.setattr(socket, "create_connection", lambda address, timeout: tried.append(address))
+    for name, words in ((None, "name must be a string of at most 64 bytes in UTF-8, got None"),
+                        (5, "name must be a string of at most 64 bytes in UTF-8, got 5"),
+                        (b"probe", "name must be a string of at most 64 bytes in UTF-8, got b'probe'"),
+                        ("x" * 65, "name must be at most 64 bytes in UTF-8 (the server's limit), got 65 bytes"),
+                        ("\u00e9" * 33, "name must be at most 64 bytes in UTF-8 (the server's limit), got 66 bytes"),
+                        ("\ud800", "name must be text UTF-8 can encode")):
+        with pytest.raises(ValueError) as refused:
+            Client("127.0.0.1", server.port, name=name)
+        assert str(refused.value).startswith(words)
+    for host in (None, b"127.0.0.1", 127, ""):
+        with pytest.raises(ValueError) as refused:
+            Client(host, server.port)
+        assert str(refused.value) == ('host must be a host name or an address as a string, e.g. "127.0.0.1", '
+                                      f"got {host!r}")
+    assert tried == []
 
 
 def test_arguments_the_wire_cannot_carry_raise_value_error_at_once_and_the_next_refusal_is_the_right_one(
         start_server):
     server = start_server("--balls", "100")
     with Client("127.0.0.1", server.port) as tank:
-        for bad in ((1, 2), "abc", (float("nan"), 0, 0), (0, float("inf"), 0)):
-            with pytest.raises(ValueError, match="velocity must be"):
+        for bad in ((1, 2), "abc", "123", b"123", {1: 1, 2: 2, 3: 3}, {0, 1, 2}, (True, 0, 0), ("1", 0, 0),
+                    np.zeros((1, 3)), np.array(["1", "2", "3"]), (1j, 0, 0)):
+            with pytest.raises(ValueError) as refused:  # a string or a mapping passed as its characters or keys
                 tank.move(bad)
+            assert str(refused.value) == ("velocity must be three numbers (x, y, z) in m/s, as a tuple, list or "
+                                          f"numpy array, got {bad!r}")
+        for bad in ((float("nan"), 0, 0), (0, float("inf"), 0), (1e40, 0, 0), (0, 0, -10**400)):
+            with pytest.raises(ValueError) as refused:  # beyond float32: FlatBuffers' OverflowError
+                tank.move(bad)
+            assert str(refused.value) == f"velocity must be finite, within a float32's range (3.4e38), got {bad!r}"
+        for good in ([0, 0, 0], np.array([0.0, 0.0, 0.0]), (np.float32(0), np.int64(0), 0.0)):
+            tank.move(good)
+        tank.move((0, 0, 0))
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # numpy's overflow warning for 1e40 too
+            for bad in (None, "abc", "0.5", True, 1e40, float("nan"), float("inf"), 0.05, 5, 1.0000001,
+                        np.float64(1.0000001)):
+                with pytest.raises(ValueError) as refused:
+                    tank.time_scale(bad)
+                assert str(refused.value) == ("time_scale's scale must be a number from 0.1 to 1 (simulated seconds "
+                                              f"per wall second), got {bad!r}")
+        for bad in (0, True, float("inf"), "1"):
+            with pytest.raises(ValueError) as refused:
+                tank.wait_for_player(timeout=bad)
+            assert str(refused.value) == ("wait_for_player's timeout must be a positive number of seconds, at most "
+                                          f"9223372036, got {bad!r}")
+        # What the server takes is what it receives, a float32: 0.0999999999 arrives as 0.1, its lowest.
+        for good, arrives in ((0.0999999999, np.float32(0.1)), (np.float32(0.5), 0.5), (1, 1.0)):
+            assert tank.time_scale(good).time_scale_set == arrives
         for call, bad in ((tank.add_balls, -5), (tank.add_balls, 0), (tank.add_balls, 1.5), (tank.step, 0), (tank.step, -1),
                           (tank.reset, -1), (lambda seed: tank.scene("drop", seed=seed), 2.5)):
             with pytest.raises(ValueError, match="must be a whole number from"):
@@ -247,10 +379,10 @@ def test_arguments_the_wire_cannot_carry_raise_value_error_at_once_and_the_next_
             with pytest.raises(ValueError) as refused:
                 call(bad)
             assert str(refused.value) == f"{what} must be a whole number {allowed}, got {bad}"
-        # Nothing of the above reached the server: the refusal a time scale of 5 raises is its own.
+        # Nothing of the above reached the server: the refusal an unknown scene raises is its own.
         with pytest.raises(FishtankError) as refused:
-            tank.time_scale(5)
-        assert refused.value.code == "invalid_value" and "SetTimeScale" in refused.value.message
+            tank.scene("cube")
+        assert refused.value.code == "invalid_value" and "unknown scene 'cube'" in refused.value.message
         assert tank.errors == [refused.value]
 
 
@@ -362,6 +494,19 @@ def test_the_example_measures_once_at_least_however_short_its_time(start_server,
     assert run.stdout.startswith("1 measurements;") and (tmp_path / "pile.png").exists()
 
 
+def test_the_example_resumes_a_simulation_left_paused_and_says_so(start_server, tmp_path):
+    server = start_server("--balls", "10")
+    with Client("127.0.0.1", server.port) as other:
+        other.pause()
+    run = _example("--port", str(server.port), "--seconds", "1", "--out", str(tmp_path / "pile.png"))
+    assert run.returncode == 0, run.stderr
+    assert run.stderr.splitlines() == ["pile_height.py: the simulation was paused; resuming it to measure"]
+    balls = int(re.search(r"with (\d+) balls", run.stdout)[1])
+    assert balls > 0, run.stdout  # paused, none poured in
+    with Client("127.0.0.1", server.port, player=False) as after:
+        assert not after.snapshot().paused
+
+
 def test_a_host_name_that_does_not_resolve_raises_cannot_connect_saying_to_check_it(monkeypatch):
     def unknown(address, timeout):  # what the resolver says of an unknown name, without asking one
         raise socket.gaierror(socket.EAI_NONAME, "Name or service not known")
@@ -428,6 +573,35 @@ def test_a_foreign_servers_bytes_that_are_not_utf8_arrive_escaped_not_as_a_decod
     with pytest.raises(FishtankError) as refused:  # an Error before the Welcome is raised by the constructor
         Client("127.0.0.1", _foreign_server(_frame(Payload.Payload.Error, error)), timeout=5)
     assert refused.value.message == "refused \\xfe\\xc3"
+
+
+def test_a_peer_that_does_not_speak_fishtank_raises_cannot_connect_saying_to_check_the_port():
+    for answer, first_line in ((b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\n\r\n", "HTTP/1.1 400 Bad Request"),
+                               (b"SSH-2.0-OpenSSH_9.2\r\n", "SSH-2.0-OpenSSH_9.2"),
+                               (b"\x10\x00\x00\x00" + bytes(16), "\\x10\\x00\\x00\\x00" + "\\x00" * 16)):
+        port = _foreign_server(answer)
+        with pytest.raises(FishtankError) as foreign:
+            Client("127.0.0.1", port, timeout=5)
+        assert foreign.value.code == "cannot_connect"
+        assert foreign.value.message == (f"the peer at 127.0.0.1:{port} does not speak Fishtank's protocol (it sent "
+                                         f"'{first_line}'); check the port: the server's 'listening on' line shows it")
+
+
+def test_a_framing_fault_after_the_welcome_ends_the_connection_as_before():
+    from fishtank.client import _frame
+    from fishtank.wire import Payload, Vec3f, Welcome
+
+    def welcome(b):
+        Welcome.Start(b)
+        Welcome.AddTankMin(b, Vec3f.CreateVec3f(b, -1, 0, -1))
+        Welcome.AddTankMax(b, Vec3f.CreateVec3f(b, 1, 2, 1))
+        Welcome.AddDt(b, 1e-3)
+        return Welcome.End(b)
+
+    with pytest.raises(ConnectionError, match="frame length 1347703880 is outside 8 .. 67108864 bytes"):
+        with Client("127.0.0.1", _foreign_server(_frame(Payload.Payload.Welcome, welcome), b"HTTP/1.1 400 "),
+                     timeout=5) as c:  # the constructor raises it where the reader got there first
+            c.snapshot()
 
 
 def test_add_balls_beyond_the_rate_limit_says_rate_limited_before_the_tank_is_full(start_server):
