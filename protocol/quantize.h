@@ -1,7 +1,7 @@
 #pragma once
 // Positions travel as 16 bits per axis over the tank bounds (Snapshot.positions):
 // a 40-unit tank gives a step of 40 / 65535 = 0.00061 units, and the encoder's
-// rounding error is at most half of that. Shared by the server (quantize) and
+// rounding error is at most half of that, plus float32's in the arithmetic. Shared by the server (quantize) and
 // every client (dequantize).
 
 #include <algorithm>
