@@ -12,7 +12,8 @@ std::string TrajectoryRecorder::open() {
 }
 
 std::string TrajectoryRecorder::at_step_boundary(const World& world) {
-  return world.steps() % options_.every != 0 ? "" : write(world);
+  // Once a step: a paused loop comes round many times at the same one.
+  return world.steps() % options_.every != 0 || last_step_ == world.steps() ? "" : write(world);
 }
 
 std::string TrajectoryRecorder::finish(const World& world) {

@@ -92,6 +92,25 @@ TEST_CASE("a recording from the start of a pour has no empty frame and ends with
   CHECK(frames.back().declared == world.ball_count());
 }
 
+TEST_CASE("a step offered again, as a paused loop does, is recorded once", "[export][record]") {
+  World world(PhysicsParams{}, kSseKernels, 1, 3);
+  world.add_balls(30);
+  const auto path = temp_file("fishtank-record-paused.lammpstrj");
+  {
+    TrajectoryRecorder recorder({path.string(), 10, 0.0, false});
+    REQUIRE(recorder.open().empty());
+    run(world, recorder, 20);
+    for (int round = 0; round < 5; ++round) CHECK(recorder.at_step_boundary(world).empty());  // paused at step 20
+    CHECK(recorder.frames() == 2);
+    CHECK(recorder.finish(world).empty());
+    CHECK(recorder.frames() == 2);  // the final state is the last frame already
+  }
+  const std::vector<Frame> frames = read_frames(path);
+  REQUIRE(frames.size() == 2);
+  CHECK(frames[0].step == 10);
+  CHECK(frames[1].step == 20);
+}
+
 TEST_CASE("no frame is recorded before --record-from's simulated second", "[export][record]") {
   World world(PhysicsParams{}, kSseKernels, 1, 3);
   world.add_balls(30);
