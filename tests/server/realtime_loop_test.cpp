@@ -173,7 +173,7 @@ TEST_CASE("a batch ends at every multiple of boundary_every, running and paused,
   RunControl control;
   LoopOptions options;
   options.control = &control;
-  options.duration = 0.4;
+  options.duration = 0.8;  // 150 steps due in 0.16 s, then 100 back to back: room for a busy machine
   options.boundary_every = 7;
   std::vector<std::uint64_t> boundaries;  // the step at each at_step_boundary
   options.at_step_boundary = [&](World& w, const LoopStatus&) {
