@@ -288,7 +288,7 @@ test('a page hidden over two seconds asks for no snapshots, and shown again deco
   assert.ok(off.serverBalls > 0 && back.serverBalls >= off.serverBalls);
 });
 
-test('the HUD says why and "disconnected" when the server stops, and the page reconnects when it returns', async () => {
+test('the HUD says why and "disconnected" when the server stops, also with the statistics hidden, and the page reconnects when it returns', async () => {
   const port = server.port;
   await server.stop();
   await waitForState(page, (st) => st.connection !== 'connected', 'the page to notice');
@@ -296,6 +296,15 @@ test('the HUD says why and "disconnected" when the server stops, and the page re
   assert.match(await waitForHud(page, (t) => /server_stopping/.test(t)), why, 'the server\'s last word, kept on close');
   const gone = /disconnected, last update [1-9]\d* s ago/;
   assert.match(await waitForHud(page, (t) => gone.test(t)), gone);
+  await page.keyboard.press('F1');  // the statistics hidden (a phone's HUD button): the loss still shows
+  const alone = await page.waitForFunction(() => {
+    const a = document.getElementById('alerts');
+    return a && !a.hidden && /disconnected, last update/.test(a.textContent) ? a.textContent : '';
+  }, { timeout: 10000 });
+  assert.match(await alone.jsonValue(), gone);
+  await page.keyboard.press('F1');
+  await page.waitForFunction(() => document.getElementById('alerts').hidden, { timeout: 10000 });
+  assert.match(await waitForHud(page, (t) => gone.test(t)), gone, 'with the statistics shown, the warnings are in them');
   server = await startServer(SERVER_ARGS, port);
   const s = await waitForState(page, (st) => st.welcomes >= 2 && st.connection === 'connected' && st.serverBalls > 0,
                                'a new Welcome and a snapshot');

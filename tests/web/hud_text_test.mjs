@@ -1,12 +1,12 @@
 // The page's HUD words (web/src/hud_text.ts, bundled for node by tests/web/CMakeLists.txt): a round trip is
-// shown no finer than the browser's clock can time it, that clock's step is found by sampling it, and the
-// control line claims this page's part only while it is known.
+// shown no finer than the browser's clock can time it, that clock's step is found by sampling it, the
+// control line claims this page's part only while it is known, and the overlap warns as the viewer's does.
 
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 import { need } from './harness.mjs';
 
-const { clockStepMs, controlText, inLineText, roundTripText } = await import(need('FISHTANK_WEB_MODULE'));
+const { clockStepMs, controlText, inLineText, overlapText, roundTripText } = await import(need('FISHTANK_WEB_MODULE'));
 
 // A clock that reads `step`-coarsened time and advances `tick` ms per read, like a browser's performance.now().
 const coarseClock = (step, tick = 0.013) => {
@@ -49,4 +49,11 @@ test('the control line says whether this page may, and once the server freed its
 test('in line for a sphere, the Player line says next, or how many are ahead (the viewer\'s twin words)', () => {
   assert.equal(inLineText(0), 'observing, next in line for a sphere');
   assert.equal(inLineText(3), 'observing, in line for a sphere: 3 ahead of you');
+});
+
+test('the overlap warns as the viewer does: beyond a tenth of the smaller radius once the balls rest, not on impact', () => {
+  assert.deepEqual(overlapText(0.004, 0.0), { text: '0.4 % of the smaller radius', warn: false });
+  assert.deepEqual(overlapText(0.28, 40.0), { text: '28.0 % of the smaller radius', warn: false });  // a pour's impacts
+  assert.deepEqual(overlapText(0.15, 0.001),
+    { text: '15.0 % of the smaller radius: stiffness too soft for the load', warn: true });
 });

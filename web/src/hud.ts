@@ -1,8 +1,10 @@
 // The statistics panel and the help overlay, as HTML over the canvas. Figures
-// that came from the server are greyed, with the reason, when the link is down.
+// that came from the server are greyed, with the reason, when the link is down;
+// with the panel hidden, its warnings still show on their own.
 
 import {
-  clockStepMs, controlText, freshnessNote, inLineText, roundTripText, stepText, threadsText, timeScaleText,
+  clockStepMs, controlText, freshnessNote, inLineText, overlapText, roundTripText, stepText, threadsText,
+  timeScaleText,
 } from './hud_text';
 import type { Connection } from './net';
 
@@ -38,12 +40,16 @@ export interface HudView {
 
 export class Hud {
   private readonly stats: HTMLElement;
+  private readonly alerts: HTMLElement;  // the statistics' warnings while they are hidden
   private readonly help: HTMLElement;
   private readonly clockStep = clockStepMs();  // round trips are shown no finer than this
 
   constructor(root: HTMLElement) {
     this.stats = document.createElement('div');
     this.stats.id = 'stats';
+    this.alerts = document.createElement('div');
+    this.alerts.id = 'alerts';
+    this.alerts.hidden = true;
     this.help = document.createElement('div');
     this.help.id = 'help';
     this.help.hidden = true;
@@ -56,7 +62,7 @@ export class Hud {
     const title = document.createElement('h2');
     title.textContent = 'Controls';
     this.help.append(title, table);
-    root.append(this.stats, this.help);
+    root.append(this.stats, this.alerts, this.help);
   }
 
   toggleHelp(): void {
@@ -65,23 +71,36 @@ export class Hud {
 
   toggleStats(): void {
     this.stats.hidden = !this.stats.hidden;
+    if (!this.stats.hidden) this.alerts.hidden = true;  // the panel says them itself from its next update
   }
 
   update(net: Connection, v: HudView): void {
-    if (this.stats.hidden) return;
     const s = net.snapshots.newest();
-    const info = net.info;
     const note = freshnessNote(net.state === 'connected', v.now, s ? net.lastUpdate : -1);
     const live = note === '';
-    const rows: [string, string, boolean][] = [];  // label, value, live (the page's own figures always are)
-    const row = (label: string, value: string, fromServer = true): void => {
-      rows.push([label, value, !fromServer || live]);
+    // A lost server, a refusal or no WebGL is said whether or not the statistics are shown.
+    const alerts: string[] = [];
+    if (v.webgl) alerts.push(`<div class="warn">${escape(v.webgl)}</div>`);
+    if (!live) alerts.push(`<div class="warn" id="freshness">${escape(note)}</div>`);
+    const notice = net.currentNotice();
+    if (notice) alerts.push(`<div class="warn notice">${escape(notice)}</div>`);
+    this.alerts.hidden = !this.stats.hidden || alerts.length === 0;
+    if (this.stats.hidden) {
+      this.alerts.innerHTML = alerts.join('');
+      return;
+    }
+    const info = net.info;
+    const rows: [string, string, string][] = [];  // label, value, class: live (the page's own figures always are)
+    const row = (label: string, value: string, fromServer = true, warn = false): void => {
+      rows.push([label, value, !fromServer || live ? (warn ? ' warn' : '') : ' stale']);
     };
     row('Frames', `${v.fps.toFixed(1)} fps   ${v.frameMs.toFixed(2)} ms/frame`, false);
     row('Physics', s ? `${s.stepsPerS.toFixed(0)} steps/s   load ${(100 * s.load).toFixed(0)} %` : '-');
     row('Time', s ? timeScaleText(s.timeScale, s.timeScaleSet, s.paused) : '-');
     row('Scene', s ? `${s.scene || '-'} (start ${s.sceneStart})` : '-');
     row('Balls', s ? `${s.ballCount}` : '-');
+    const overlap = s ? overlapText(s.maxOverlap, s.kineticEnergyPerBall) : null;
+    row('Overlap', overlap ? overlap.text : '-', true, overlap?.warn);
     row('Threads', info ? threadsText(s ? s.threadsStepping : 0, info.threads) : '-');
     row('Server', info ? `${info.variant} (SIMD ${info.simd})` : location.host);
     row('Step', info ? stepText(info.dt, info.stepsPerContact, info.tolerance) : '-');
@@ -98,14 +117,11 @@ export class Hud {
       row('Control', controlText(info.mayControl, info.controlPolicy));
     }
 
-    const lines = rows.map(([label, value, fresh]) =>
-      `<div class="row${fresh ? '' : ' stale'}"><span class="label">${label}</span><span>${escape(value)}</span></div>`);
-    if (v.webgl) lines.unshift(`<div class="warn">${escape(v.webgl)}</div>`);
-    if (!live) lines.push(`<div class="warn" id="freshness">${escape(note)}</div>`);
-    const notice = net.currentNotice();
-    if (notice) lines.push(`<div class="warn notice">${escape(notice)}</div>`);
-    lines.push('<div class="dim">H (or ? on a touch screen): help</div>');
-    this.stats.innerHTML = lines.join('');
+    const lines = rows.map(([label, value, kind]) =>
+      `<div class="row${kind}"><span class="label">${label}</span><span>${escape(value)}</span></div>`);
+    const webgl = v.webgl ? 1 : 0;  // why nothing is drawn comes first
+    this.stats.innerHTML = [...alerts.slice(0, webgl), ...lines, ...alerts.slice(webgl),
+      '<div class="dim">H (or ? on a touch screen): help</div>'].join('');
   }
 }
 

@@ -2,6 +2,17 @@
 
 // Below this the world runs in slow motion (kSlowMotionBelow, common/time_scale.h).
 const SLOW_MOTION_BELOW = 0.98;
+// A resting overlap deeper than this share of the smaller radius says k is too soft, and balls count as
+// resting below this mean kinetic energy per ball, J (common/overlap.h).
+const OVERLAP_WARNING = 0.10;
+const RESTING_ENERGY_PER_BALL = 5e-3;
+
+// "0.4 % of the smaller radius", with ": stiffness too soft for the load" (warn) once the balls rest
+// (an impact's overlap, while balls fly in, is no sign of a soft k).
+export function overlapText(fraction: number, energyPerBall: number): { text: string; warn: boolean } {
+  const warn = fraction > OVERLAP_WARNING && energyPerBall <= RESTING_ENERGY_PER_BALL;
+  return { text: `${(100 * fraction).toFixed(1)} % of the smaller radius${warn ? ': stiffness too soft for the load' : ''}`, warn };
+}
 
 // Why the server's figures are not live, or '' when they are.
 export function freshnessNote(connected: boolean, now: number, lastUpdate: number): string {

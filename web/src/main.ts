@@ -23,7 +23,8 @@ const wsUrl = params.get('ws') ?? `${location.protocol === 'https:' ? 'wss' : 'w
 const canvas = document.getElementById('view') as HTMLCanvasElement;
 const gl = canvas.getContext('webgl2', { antialias: true });
 let renderer = gl ? new Renderer(gl) : null;
-const webglProblem = gl ? '' : 'This browser gives the page no WebGL2 context: nothing can be drawn (the HUD still works).';
+const webglProblem = gl ? '' : 'This browser gives the page no WebGL2 context: nothing can be drawn (the HUD still works); '
+  + 'open the page in another browser, or turn hardware acceleration on in its settings.';
 // A GPU reset, or a phone reclaiming memory from a tab in the background, takes
 // the context and everything made in it; preventDefault asks for it back.
 let contextLost = false;
@@ -109,14 +110,15 @@ function frame(nowMs: number): void {
   }
   ownPlayer = own >= 0 ? players[own] : null;
   drawnBalls = pair ? pair.to.ballCount : 0;
+  const drawing = renderer !== null;  // frames count only where a picture is drawn (none while the context is lost)
   renderer?.draw(camera.viewProjection(canvas.width / Math.max(1, canvas.height)), pair, players, own, showTank);
 
-  ++frames;
+  if (drawing) ++frames;
   ++framesDrawn;
   const elapsed = nowMs - fpsStarted;
   if (elapsed >= 500) {
     fps = (1000 * frames) / elapsed;
-    frameMs = elapsed / frames;
+    frameMs = frames > 0 ? elapsed / frames : 0;
     frames = 0;
     fpsStarted = nowMs;
   }

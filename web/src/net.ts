@@ -288,6 +288,8 @@ export class Connection {
       threadsStepping: s.threadsStepping(),
       timeScale: s.timeScale(),
       timeScaleSet: s.timeScaleSet(),
+      maxOverlap: s.maxOverlap(),
+      kineticEnergyPerBall: s.kineticEnergyPerBall(),
       paused: s.paused(),
       scene: s.scene() ?? '',
       sceneStart: s.sceneStart(),

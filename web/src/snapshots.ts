@@ -25,6 +25,8 @@ export interface Frame {
   threadsStepping: number;
   timeScale: number;
   timeScaleSet: number;
+  maxOverlap: number;  // the deepest overlap, a share of the smaller radius
+  kineticEnergyPerBall: number;  // J
   paused: boolean;
   scene: string;
   sceneStart: number;
