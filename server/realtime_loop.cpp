@@ -18,6 +18,9 @@ constexpr double kWakeLeadSeconds = 0.0003;
 // The rates snapshots carry are measured over at most this long, whatever the
 // status line's interval: a viewer's figures must not wait for a long one.
 constexpr double kLiveWindowSeconds = 1.0;
+// After people pause, resume or set another time scale, the live window starts again and
+// ends after this: the viewers' figures then tell the new pace within it, not a second on.
+constexpr double kWindowAfterChangeSeconds = 0.2;
 
 double seconds_between(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double>(to - from).count();
@@ -32,6 +35,7 @@ double seconds_between(Clock::time_point from, Clock::time_point to) {
 struct RateWindow {
   double start;
   double length;
+  double first_length = 0.0;  // above 0: this window ends after that instead (restart)
   std::uint64_t steps = 0;
   double busy = 0.0;
   double asked = 0.0;  // simulated seconds the time scale set asked for
@@ -46,13 +50,14 @@ struct RateWindow {
   // asked did not change, simulated seconds per wall second.
   bool close(double end, double dt, double scale_now, LoopStatus& status) {
     const double span = end - start;
-    if (span < length) return false;
+    if (span < (first_length > 0.0 ? first_length : length)) return false;
     status.steps_per_s = steps / span;
     status.load = busy / span;
     status.time_scale = asked > 0.0 && scale_now > 0.0 ? steps * dt / asked * scale_now : steps * dt / span;
     *this = {end, length};
     return true;
   }
+  void restart(double at, double ends_after) { *this = {at, length, std::min(ends_after, length)}; }
 };
 }  // namespace
 
@@ -92,6 +97,8 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
   LoopStatus status;       // what at_step_boundary sees: rates of the latest live window
   RateWindow live{0.0, std::min(options.status_interval, kLiveWindowSeconds)};
   RateWindow line{0.0, options.status_interval};
+  bool was_paused = control.paused;
+  double scale_was = control.time_scale;
 
   while (!stop.load(std::memory_order_relaxed)) {
     const double now = seconds_between(start, Clock::now());
@@ -99,6 +106,11 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
     const Clock::time_point busy_start = Clock::now();
     const double clock_before = sim_clock;
     if (options.at_step_boundary) options.at_step_boundary(world, status);
+    if (control.paused != was_paused || control.time_scale != scale_was) {
+      live.restart(clock_before, kWindowAfterChangeSeconds);
+      was_paused = control.paused;
+      scale_was = control.time_scale;
+    }
     // A step is due every dt / time_scale of wall time; a paused world owes none.
     const double wall_per_step = dt / control.time_scale;
     if (control.paused) {

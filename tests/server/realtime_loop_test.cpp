@@ -231,3 +231,36 @@ TEST_CASE("a window in which people resumed or set another time scale is not rea
   }
   CHECK(running >= 4);
 }
+
+TEST_CASE("the rates between batches tell a pause or a resume within a fifth of a second, not a second on",
+          "[server][loop]") {
+  World world(with_stiffness(25000.0f), kSseKernels, 1, 5);
+  place_lattice(world, 100);
+  RunControl control;
+  LoopOptions options;
+  options.control = &control;
+  options.duration = 2.3;
+  const auto start = std::chrono::steady_clock::now();
+  auto since_start = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  int paused_checked = 0, running_checked = 0;
+  options.at_step_boundary = [&](World& w, const LoopStatus& s) {
+    const double t = since_start();
+    // Running 0.7 s (the live window closes at 1 s), paused until 1.4 s, then running again.
+    control.paused = t >= 0.7 && t < 1.4;
+    INFO("t " << t << " s: " << s.steps_per_s << " steps/s, time scale " << s.time_scale);
+    if (t > 1.0 && t < 1.4) {  // paused 0.3 s: the steps of the running part are gone
+      CHECK(s.steps_per_s == 0.0);
+      ++paused_checked;
+    }
+    if (t > 1.7) {  // running again 0.3 s (half the pace at least: a busy machine may drop steps)
+      CHECK(s.steps_per_s > 0.5 / w.dt());
+      CHECK(s.time_scale > 0.5);
+      ++running_checked;
+    }
+  };
+  const std::atomic<bool> stop{false};
+  TunedStepper stepper(world, false);
+  run_realtime(stepper, options, stop);
+  CHECK(paused_checked > 10);
+  CHECK(running_checked > 10);
+}
