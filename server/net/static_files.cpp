@@ -71,7 +71,10 @@ std::string StaticFiles::not_found_page() const {
   const std::string head =
       "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>Fishtank: not found</title>"
       "</head>\n<body>\n";
-  if (page_built_) return head + "<h1>404: not found</h1>\n<p>No such file in the viewer's page.</p>\n</body></html>\n";
+  if (page_built_)
+    return head +
+           "<h1>404: not found</h1>\n<p>No such file in the viewer's page: the viewer is at <a "
+           "href=\"/\">/</a>.</p>\n</body></html>\n";
   return head +
          "<h1>404: the browser viewer is not built</h1>\n"
          // The folder is named in the server's log, not to every browser that asks.

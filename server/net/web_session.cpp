@@ -88,11 +88,16 @@ void WebSession::on_request() {
     return respond_text(http::status::not_found, "<p>404: WebSocket connections upgrade at /ws only.</p>\n",
                         request.keep_alive());
   }
-  if (path && *path == "/ws")  // someone opened the socket's address in a browser, or fetched it with curl
-    return respond_text(http::status::upgrade_required,
-                        "<p>426: /ws is the viewer's WebSocket, which a browser opens from the page; open / instead."
-                        "</p>\n",
-                        request.keep_alive());
+  if (path && *path == "/ws") {  // someone opened the socket's address in a browser, or fetched it with curl
+    http::response<http::string_body> response{http::status::upgrade_required, request.version()};
+    response.set(http::field::upgrade, "websocket");  // what the status asks for (RFC 9110)
+    response.set(http::field::content_type, "text/html; charset=utf-8");
+    response.body() =
+        "<p>426: /ws is the viewer's WebSocket, which a browser opens from the page; open / instead.</p>\n";
+    response.keep_alive(request.keep_alive());
+    response.prepare_payload();
+    return respond(std::move(response));
+  }
   if (request.method() != http::verb::get && request.method() != http::verb::head) {
     http::response<http::string_body> response{http::status::method_not_allowed, request.version()};
     response.set(http::field::allow, "GET, HEAD");

@@ -218,8 +218,10 @@ def test_other_methods_get_405_upgrades_elsewhere_404_ws_without_upgrade_426_and
                "Sec-WebSocket-Key": "dGhlIHNhbXBsZSBub25jZQ=="}
     assert _request(port, "GET", "/index.html", upgrade)[0] == 404
     assert _request(port, "GET", "/ws", {"X-Filler": "a" * 20000})[0] == 431
-    status, _, body = _request(port, "GET", "/ws")  # the socket's address opened in a browser
-    assert status == 426 and b"open / instead" in body
+    status, headers, body = _request(port, "GET", "/ws")  # the socket's address opened in a browser
+    assert status == 426 and headers["Upgrade"] == "websocket" and b"open / instead" in body
+    status, _, body = _request(port, "GET", "/no-such-file.html")
+    assert status == 404 and b'the viewer is at <a href="/">/</a>' in body
 
 
 def test_without_a_built_page_the_server_says_how_to_build_it_and_ws_still_works(start_server, tmp_path):
