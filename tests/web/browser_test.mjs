@@ -294,7 +294,7 @@ test('the HUD says why and "disconnected" when the server stops, also with the s
   await waitForState(page, (st) => st.connection !== 'connected', 'the page to notice');
   const why = /server_stopping: the server is stopping: it was stopped \(Ctrl-C or SIGTERM\); reconnecting/;
   assert.match(await waitForHud(page, (t) => /server_stopping/.test(t)), why, 'the server\'s last word, kept on close');
-  const gone = /disconnected, last update [1-9]\d* s ago/;
+  const gone = /disconnected, last update [1-9]\d* s ago; trying again every second/;
   assert.match(await waitForHud(page, (t) => gone.test(t)), gone);
   await page.keyboard.press('F1');  // the statistics hidden (a phone's HUD button): the loss still shows
   const alone = await page.waitForFunction(() => {

@@ -81,7 +81,8 @@ export class Hud {
     // A lost server, a refusal or no WebGL is said whether or not the statistics are shown.
     const alerts: string[] = [];
     if (v.webgl) alerts.push(`<div class="warn">${escape(v.webgl)}</div>`);
-    if (!live) alerts.push(`<div class="warn" id="freshness">${escape(note)}</div>`);
+    const retry = net.retrying ? '; trying again every second' : '';  // after the server's notice has gone
+    if (!live) alerts.push(`<div class="warn" id="freshness">${escape(note + retry)}</div>`);
     const notice = net.currentNotice();
     if (notice) alerts.push(`<div class="warn notice">${escape(notice)}</div>`);
     this.alerts.hidden = !this.stats.hidden || alerts.length === 0;

@@ -43,6 +43,7 @@ const seconds = (): number => performance.now() / 1000;
 
 export class Connection {
   state: State = 'connecting';
+  retrying = false;  // a connection was lost and is tried again every RECONNECT_MS
   info: ServerInfo | null = null;
   readonly snapshots = new SnapshotBuffer();
   lastUpdate = -1;  // seconds() of the newest snapshot, -1 before any
@@ -145,6 +146,7 @@ export class Connection {
       this.lastError = '';
       this.state = 'disconnected';
       this.socket = null;
+      this.retrying = true;
       setTimeout(() => this.connect(), RECONNECT_MS);
     };
   }
@@ -235,6 +237,7 @@ export class Connection {
     this.received.clear();
     this.snapshots.clear();
     this.state = 'connected';
+    this.retrying = false;
     ++this.welcomes;
     if (!this.watching) this.send(wire.watching(false));
   }
