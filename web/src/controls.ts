@@ -17,16 +17,16 @@ export interface Actions {
   toggleTank: boolean;  // T
   toggleHelp: boolean;  // H
   toggleHud: boolean;  // F1
-  addBalls: boolean;  // B
+  addBalls: number;  // B presses (a slow page may take several in one frame)
   togglePause: boolean;  // P
   singleStep: boolean;  // O: pauses first if running
   reset: boolean;  // R
-  timeScaleChange: number;  // ]: +1 faster, [: -1 slower
+  timeScaleChange: number;  // rungs: ] +1 faster, [ -1 slower, each press
   scene: number;  // 1-4 as 0-3; -1: none
 }
 
 const noActions = (): Actions => ({
-  toggleTank: false, toggleHelp: false, toggleHud: false, addBalls: false, togglePause: false, singleStep: false,
+  toggleTank: false, toggleHelp: false, toggleHud: false, addBalls: 0, togglePause: false, singleStep: false,
   reset: false, timeScaleChange: 0, scene: -1,
 });
 
@@ -43,8 +43,9 @@ export function sandboxFrames(a: Actions, newest: Frame | null): Uint8Array[] {
   if (a.scene >= 0 && a.scene < SCENE_NAMES.length) frames.push(wire.reset(SCENE_NAMES[a.scene]));
   if (a.reset) frames.push(wire.reset(''));
   if (a.timeScaleChange !== 0) {
-    const current = newest.timeScaleSet > 0 ? newest.timeScaleSet : 1;  // a server that does not say runs at real time
-    frames.push(wire.setTimeScale(nextTimeScale(current, a.timeScaleChange)));
+    let scale = newest.timeScaleSet > 0 ? newest.timeScaleSet : 1;  // a server that does not say runs at real time
+    for (let rung = 0; rung < Math.abs(a.timeScaleChange); ++rung) scale = nextTimeScale(scale, Math.sign(a.timeScaleChange));
+    frames.push(wire.setTimeScale(scale));
   }
   if (a.togglePause) frames.push(wire.pause(!newest.paused));
   if (a.singleStep) {
@@ -68,7 +69,7 @@ export class Input {
 
   constructor(canvas: HTMLCanvasElement, overlay: HTMLElement) {
     this.pad = new TouchPad(overlay, (b) => {
-      if (b === 'addBalls') this.pending.addBalls = true;
+      if (b === 'addBalls') ++this.pending.addBalls;
       else if (b === 'help') this.pending.toggleHelp = true;
       else this.pending.toggleHud = true;
     });
@@ -158,12 +159,12 @@ export class Input {
       case 'KeyT': a.toggleTank = true; break;
       case 'KeyH': a.toggleHelp = true; break;
       case 'F1': a.toggleHud = true; break;
-      case 'KeyB': a.addBalls = true; break;
+      case 'KeyB': ++a.addBalls; break;
       case 'KeyP': a.togglePause = true; break;
       case 'KeyO': a.singleStep = true; break;
       case 'KeyR': a.reset = true; break;
-      case 'BracketLeft': a.timeScaleChange = -1; break;
-      case 'BracketRight': a.timeScaleChange = 1; break;
+      case 'BracketLeft': --a.timeScaleChange; break;
+      case 'BracketRight': ++a.timeScaleChange; break;
       case 'Digit1': case 'Digit2': case 'Digit3': case 'Digit4': a.scene = Number(code.slice(5)) - 1; break;
       case 'Space': break;  // held for up; not a page scroll
       default: return false;

@@ -86,7 +86,7 @@ function frame(nowMs: number): void {
   if (a.toggleHelp) hud.toggleHelp();
   if (a.toggleHud) hud.toggleStats();
   if (a.toggleTank) showTank = !showTank;
-  if (a.addBalls) net.send(wire.addBalls(BALLS_PER_PRESS));
+  for (let press = 0; press < a.addBalls; ++press) net.send(wire.addBalls(BALLS_PER_PRESS));
   for (const f of sandboxFrames(a, net.snapshots.newest())) net.send(f);
   input.driveCamera(camera);
 
