@@ -34,6 +34,7 @@ canvas.addEventListener('webglcontextlost', (e) => {
   e.preventDefault();
   contextLost = true;
   renderer = null;
+  canvas.style.opacity = '0';  // the browser paints a lost canvas white, under the statistics; it keeps its events
 });
 canvas.addEventListener('webglcontextrestored', () => {
   try {
@@ -45,6 +46,7 @@ canvas.addEventListener('webglcontextrestored', () => {
   }
   kindsOf = null;  // the new renderer is told the kinds again
   contextLost = false;
+  canvas.style.opacity = '';
 });
 const overlay = document.getElementById('overlay')!;
 const input = new Input(canvas, overlay);
