@@ -310,6 +310,7 @@ test('the HUD says why and "disconnected" when the server stops, also with the s
                                'a new Welcome and a snapshot');
   assert.ok(s.serverBalls <= SERVER_BALLS, `the new server's world, not the old one's ${SERVER_BALLS + 1000} balls`);
   assert.doesNotMatch(await waitForHud(page, (t) => !/disconnected/.test(t)), /disconnected/);
+  assert.match(await hudText(page), /connected again: the server is back/, 'the return is said');
 });
 
 test('where every player sphere is taken, the page observes in line, says why, offers no stick, P is refused, and it gets the sphere its holder frees', async () => {

@@ -34,7 +34,8 @@ export interface ServerInfo {
   playerId: number;
   snapshotRateHz: number;
   controlPolicy: string;
-  mayControl: boolean | null;  // null: unknown since the server freed this page's sphere
+  mayControl: boolean;
+  observersMayControl: boolean;  // whether it may without a sphere (once the server frees its own)
 }
 
 export type State = 'connecting' | 'connected' | 'disconnected';
@@ -176,7 +177,7 @@ export class Connection {
         // The sphere was freed: from now on this page observes.
         if (e.code() === ErrorCode.player_idle && this.info) {
           this.info.hasPlayer = false;
-          this.info.mayControl = null;  // the Welcome's answer was a player's; the policy decides an observer's
+          this.info.mayControl = this.info.observersMayControl;
         }
         return this.say(text);
       }
@@ -229,6 +230,7 @@ export class Connection {
       snapshotRateHz: w.snapshotRateHz(),
       controlPolicy: w.controlPolicy() ?? 'not stated by the server',
       mayControl: w.mayControl(),
+      observersMayControl: w.observersMayControl(),
     };
     this.observing = '';
     this.inLine = false;
@@ -237,6 +239,7 @@ export class Connection {
     this.received.clear();
     this.snapshots.clear();
     this.state = 'connected';
+    if (this.retrying) this.say('connected again: the server is back');
     this.retrying = false;
     ++this.welcomes;
     if (!this.watching) this.send(wire.watching(false));
