@@ -66,9 +66,8 @@ std::string step_text(float dt, float steps_per_contact, float tolerance) {
   return text;
 }
 
-std::string control_text(std::optional<bool> may_control, const std::string& policy) {
-  if (!may_control) return policy;
-  return (*may_control ? "yours (P O R [ ] 1-4): " : "not yours: ") + policy;
+std::string control_text(bool may_control, const std::string& policy) {
+  return (may_control ? "yours (P O R [ ] 1-4): " : "not yours: ") + policy;
 }
 
 std::string in_line_text(std::uint32_t ahead) {

@@ -42,9 +42,8 @@ OverlapText overlap_text(float fraction, float energy_per_ball);
 // not say; "-" without a dt.
 std::string step_text(float dt, float steps_per_contact, float tolerance);
 
-// Who may use the sandbox's controls, for the HUD: this viewer's part first, where it is known (the Welcome's
-// answer no longer holds once the server frees this viewer's sphere: then the policy alone).
-std::string control_text(std::optional<bool> may_control, const std::string& policy);
+// Who may use the sandbox's controls, for the HUD: this viewer's part, then the policy.
+std::string control_text(bool may_control, const std::string& policy);
 
 // The Player line while in line for a sphere (InLine): "observing, next in line for a sphere", or how many
 // are ahead.

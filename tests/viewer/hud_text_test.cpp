@@ -86,8 +86,6 @@ TEST_CASE("a time scale people set is not slow motion, a shortfall against it is
 TEST_CASE("the control line says first whether this viewer may, then the server's policy") {
   CHECK(control_text(true, "players may") == "yours (P O R [ ] 1-4): players may");
   CHECK(control_text(false, "observers may not") == "not yours: observers may not");
-  // A sphere freed by the server: the Welcome's "yours" was a player's; the policy alone says who may now.
-  CHECK(control_text(std::nullopt, "clients with a player sphere may") == "clients with a player sphere may");
 }
 
 TEST_CASE("in line for a sphere, the Player line says next, or how many are ahead") {

@@ -1,6 +1,6 @@
 // The page's HUD words (web/src/hud_text.ts, bundled for node by tests/web/CMakeLists.txt): a round trip is
 // shown no finer than the browser's clock can time it, that clock's step is found by sampling it, the
-// control line claims this page's part only while it is known, and the overlap warns as the viewer's does.
+// control line says this page's part, then the policy, and the overlap warns as the viewer's does.
 
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
@@ -40,10 +40,9 @@ test('a round trip has only the decimals its clock resolves', () => {
   assert.equal(roundTripText(-1, 0.1), '-');
 });
 
-test('the control line says whether this page may, and once the server freed its sphere the policy alone', () => {
+test('the control line says whether this page may, then the policy', () => {
   assert.equal(controlText(true, 'players may'), 'yours (P O R [ ] 1-4): players may');
   assert.equal(controlText(false, 'observers may not'), 'not yours: observers may not');
-  assert.equal(controlText(null, 'clients with a player sphere may'), 'clients with a player sphere may');
 });
 
 test('in line for a sphere, the Player line says next, or how many are ahead (the viewer\'s twin words)', () => {

@@ -205,11 +205,10 @@ void NetClient::on_frame() {
         return change_info(
             [&](ServerInfo& info) {
               info.observing = text;
-              // The sphere was freed: from now on this viewer observes. The Welcome's answer was a
-              // player's; the policy decides an observer's.
+              // The sphere was freed: from now on this viewer observes, and may control as observers may.
               if (e.code() == wire::ErrorCode::player_idle) {
                 info.has_player = false;
-                info.may_control.reset();
+                info.may_control = info.observers_may_control;
               }
             },
             "server: " + text);
@@ -265,6 +264,7 @@ void NetClient::on_welcome(const wire::Welcome& w) {
   info->control_policy =
       w.control_policy() ? server_text(w.control_policy()->str()) : "not stated by the server";
   info->may_control = w.may_control();
+  info->observers_may_control = w.observers_may_control();
   info_ = info;
   kinds_ = std::make_shared<std::vector<std::uint8_t>>();
   received_.clear();

@@ -25,8 +25,9 @@ struct ServerInfo {
   float tolerance = 0.0f;          // the per-collision error dt was chosen for; 0: dt given
   std::vector<BallKind> kinds;     // indexed by a ball's kind number
   std::uint32_t client_id = 0;
-  std::string control_policy;       // who may pause, step, reset, switch scene, set the time scale
-  std::optional<bool> may_control;  // whether this viewer may; unknown once the server freed its sphere
+  std::string control_policy;          // who may pause, step, reset, switch scene, set the time scale
+  bool may_control = false;            // whether this viewer may
+  bool observers_may_control = false;  // whether it may without a sphere (once the server frees its own)
   std::uint32_t player_id = 0;
   bool has_player = false;
   // Without a sphere, the server's reason (player_limit: in line for one; player_idle: it was freed).

@@ -51,10 +51,8 @@ export function stepText(dt: number, stepsPerContact: number, tolerance: number)
   return `${ms} ms (given), ${stepsPerContact.toFixed(1)} steps per contact`;
 }
 
-// Who may use the controls, this page's part first where it is known: null once the server freed this page's
-// sphere (the Welcome's answer was a player's), and then the policy alone.
-export function controlText(mayControl: boolean | null, policy: string): string {
-  if (mayControl === null) return policy;
+// Who may use the controls: this page's part, then the policy.
+export function controlText(mayControl: boolean, policy: string): string {
   return (mayControl ? 'yours (P O R [ ] 1-4): ' : 'not yours: ') + policy;
 }
 
