@@ -74,6 +74,27 @@ void place_lattice(World& world, int balls) {
                      {0.0f, 0.0f, 0.0f});
 }
 
+// A lattice of 100 balls in a loop that people control (control), run for `seconds`, set up in options.
+struct ControlledLoop {
+  World world{with_stiffness(25000.0f), kSseKernels, 1, 5};
+  RunControl control;
+  LoopOptions options;
+  std::chrono::steady_clock::time_point start;
+
+  explicit ControlledLoop(double seconds) {
+    place_lattice(world, 100);
+    options.control = &control;
+    options.duration = seconds;
+  }
+  double since_start() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
+  void run() {
+    const std::atomic<bool> stop{false};
+    TunedStepper stepper(world, false);
+    start = std::chrono::steady_clock::now();
+    run_realtime(stepper, options, stop);
+  }
+};
+
 }  // namespace
 
 TEST_CASE("a world far over its real-time budget runs in slow motion, and the loop keeps its rate", "[server][loop]") {
@@ -168,58 +189,42 @@ TEST_CASE("the rates seen between batches cover the last second, however far apa
 
 TEST_CASE("a batch ends at every multiple of boundary_every, running and paused, so a recording gets each",
           "[server][loop]") {
-  World world(with_stiffness(25000.0f), kSseKernels, 1, 5);
-  place_lattice(world, 100);
-  RunControl control;
-  LoopOptions options;
-  options.control = &control;
-  options.duration = 0.8;  // 150 steps due in 0.16 s, then 100 back to back: room for a busy machine
-  options.boundary_every = 7;
+  ControlledLoop loop(0.8);  // 150 steps due in 0.16 s, then 100 back to back: room for a busy machine
+  loop.options.boundary_every = 7;
   std::vector<std::uint64_t> boundaries;  // the step at each at_step_boundary
-  options.at_step_boundary = [&](World& w, const LoopStatus&) {
+  loop.options.at_step_boundary = [&](World& w, const LoopStatus&) {
     boundaries.push_back(w.steps());
-    if (w.steps() >= 150 && !control.paused) {  // then paused, a run of asked-for steps back to back
-      control.paused = true;
-      control.steps_to_run = 100;
+    if (w.steps() >= 150 && !loop.control.paused) {  // then paused, a run of asked-for steps back to back
+      loop.control.paused = true;
+      loop.control.steps_to_run = 100;
     }
   };
-  const std::atomic<bool> stop{false};
-  TunedStepper stepper(world, false);
-  run_realtime(stepper, options, stop);
-  REQUIRE(control.steps_to_run == 0);
-  REQUIRE(world.steps() >= 250);
-  for (std::uint64_t step = 0; step + 7 <= world.steps(); step += 7) {
+  loop.run();
+  REQUIRE(loop.control.steps_to_run == 0);
+  REQUIRE(loop.world.steps() >= 250);
+  for (std::uint64_t step = 0; step + 7 <= loop.world.steps(); step += 7) {
     INFO("step " << step);
     CHECK(std::find(boundaries.begin(), boundaries.end(), step) != boundaries.end());
   }
 }
 
 TEST_CASE("a window in which people resumed or set another time scale is not read as slow motion", "[server][loop]") {
-  World world(with_stiffness(25000.0f), kSseKernels, 1, 5);
-  place_lattice(world, 100);
-  RunControl control;
-  control.paused = true;
-  LoopOptions options;
-  options.control = &control;
-  options.duration = 1.6;
-  options.status_interval = 0.25;
-  const auto start = std::chrono::steady_clock::now();
-  auto since_start = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-  options.at_step_boundary = [&](World&, const LoopStatus&) {
-    const double t = since_start();
-    control.paused = t < 0.4;                  // paused, then resumed at half the clock
-    control.time_scale = t < 0.9 ? 0.5 : 1.0;  // then back to real time
+  ControlledLoop loop(1.6);
+  loop.control.paused = true;
+  loop.options.status_interval = 0.25;
+  loop.options.at_step_boundary = [&](World&, const LoopStatus&) {
+    const double t = loop.since_start();
+    loop.control.paused = t < 0.4;                  // paused, then resumed at half the clock
+    loop.control.time_scale = t < 0.9 ? 0.5 : 1.0;  // then back to real time
   };
   struct Line {
     double at, time_scale, asked;
   };
   std::vector<Line> lines;
-  options.on_status = [&](const World&, const LoopStatus& s) {
-    lines.push_back({since_start(), s.time_scale, control.paused ? 0.0 : control.time_scale});
+  loop.options.on_status = [&](const World&, const LoopStatus& s) {
+    lines.push_back({loop.since_start(), s.time_scale, loop.control.paused ? 0.0 : loop.control.time_scale});
   };
-  const std::atomic<bool> stop{false};
-  TunedStepper stepper(world, false);
-  run_realtime(stepper, options, stop);
+  loop.run();
   REQUIRE(lines.size() >= 5);
   int running = 0;
   for (const Line& l : lines) {
@@ -234,19 +239,12 @@ TEST_CASE("a window in which people resumed or set another time scale is not rea
 
 TEST_CASE("the rates between batches tell a pause or a resume within a fifth of a second, not a second on",
           "[server][loop]") {
-  World world(with_stiffness(25000.0f), kSseKernels, 1, 5);
-  place_lattice(world, 100);
-  RunControl control;
-  LoopOptions options;
-  options.control = &control;
-  options.duration = 2.3;
-  const auto start = std::chrono::steady_clock::now();
-  auto since_start = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  ControlledLoop loop(2.3);
   int paused_checked = 0, running_checked = 0;
-  options.at_step_boundary = [&](World& w, const LoopStatus& s) {
-    const double t = since_start();
+  loop.options.at_step_boundary = [&](World& w, const LoopStatus& s) {
+    const double t = loop.since_start();
     // Running 0.7 s (the live window closes at 1 s), paused until 1.4 s, then running again.
-    control.paused = t >= 0.7 && t < 1.4;
+    loop.control.paused = t >= 0.7 && t < 1.4;
     INFO("t " << t << " s: " << s.steps_per_s << " steps/s, time scale " << s.time_scale);
     if (t > 1.0 && t < 1.4) {  // paused 0.3 s: the steps of the running part are gone
       CHECK(s.steps_per_s == 0.0);
@@ -258,9 +256,7 @@ TEST_CASE("the rates between batches tell a pause or a resume within a fifth of 
       ++running_checked;
     }
   };
-  const std::atomic<bool> stop{false};
-  TunedStepper stepper(world, false);
-  run_realtime(stepper, options, stop);
+  loop.run();
   CHECK(paused_checked > 10);
   CHECK(running_checked > 10);
 }
