@@ -148,8 +148,10 @@ void WorkerPool::wait_for_chunks() {
 
 void WorkerPool::run(std::uint32_t count, const Phase& phase) { run(count, phase, granule_, kMinItemsPerThread); }
 
-int WorkerPool::threads_for(std::uint32_t count) const {
-  return std::max(1, static_cast<int>(std::min<std::uint32_t>(count / kMinItemsPerThread, active_limit_)));
+int WorkerPool::threads_for(std::uint32_t count) const { return active_threads(count, kMinItemsPerThread); }
+
+int WorkerPool::active_threads(std::uint32_t count, std::uint32_t min_per_thread) const {
+  return std::max(1, static_cast<int>(std::min<std::uint32_t>(count / min_per_thread, active_limit_)));
 }
 
 void WorkerPool::run_costly(std::uint32_t count, std::uint32_t min_per_thread, const Phase& phase) {
@@ -173,7 +175,7 @@ void WorkerPool::place_threads(bool one_per_cpu) {
 
 void WorkerPool::run(std::uint32_t count, const Phase& phase, std::uint32_t granule, std::uint32_t min_per_thread) {
   place_threads(active_limit_ == thread_count_);
-  const int active = static_cast<int>(std::min<std::uint32_t>(count / min_per_thread, active_limit_));
+  const int active = active_threads(count, min_per_thread);
   if (active <= 1) {
     if (count > 0) phase(0, count, 0);
     items_done_[0].items += count;

@@ -69,6 +69,8 @@ class WorkerPool {
   static int hardware_threads();
 
  private:
+  // The threads a run over `count` items takes: at least min_per_thread each, at most the active limit, one at least.
+  int active_threads(std::uint32_t count, std::uint32_t min_per_thread) const;
   // Few enough that claiming is cheap, enough that a stalled thread's work is taken in small pieces.
   static constexpr int kChunksPerThread = 4;
 
