@@ -97,7 +97,7 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
   LoopStatus status;       // what at_step_boundary sees: rates of the latest live window
   RateWindow live{0.0, std::min(options.status_interval, kLiveWindowSeconds)};
   RateWindow line{0.0, options.status_interval};
-  bool was_paused = control.paused;
+  bool paused_was = control.paused;
   double scale_was = control.time_scale;
 
   while (!stop.load(std::memory_order_relaxed)) {
@@ -106,9 +106,9 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
     const Clock::time_point busy_start = Clock::now();
     const double clock_before = sim_clock;
     if (options.at_step_boundary) options.at_step_boundary(world, status);
-    if (control.paused != was_paused || control.time_scale != scale_was) {
+    if (control.paused != paused_was || control.time_scale != scale_was) {
       live.restart(clock_before, kWindowAfterChangeSeconds);
-      was_paused = control.paused;
+      paused_was = control.paused;
       scale_was = control.time_scale;
     }
     // A step is due every dt / time_scale of wall time; a paused world owes none.

@@ -112,10 +112,10 @@ function frame(nowMs: number): void {
   }
   ownPlayer = own >= 0 ? players[own] : null;
   drawnBalls = pair ? pair.to.ballCount : 0;
-  const drawing = renderer !== null;  // frames count only where a picture is drawn (none while the context is lost)
-  renderer?.draw(camera.viewProjection(canvas.width / Math.max(1, canvas.height)), pair, players, own, showTank);
-
-  if (drawing) ++frames;
+  if (renderer) {  // frames count only where a picture is drawn (none while the context is lost)
+    renderer.draw(camera.viewProjection(canvas.width / Math.max(1, canvas.height)), pair, players, own, showTank);
+    ++frames;
+  }
   ++framesDrawn;
   const elapsed = nowMs - fpsStarted;
   if (elapsed >= 500) {
