@@ -14,7 +14,7 @@
 namespace fishtank::accuracy {
 
 enum class Scheme {
-  kVerlet,           // the product's: velocity Verlet, dashpot on the half-step velocity
+  kVerlet,           // LAMMPS-like velocity Verlet, dashpot on the half-step velocity (the product replaced it)
   kSymplecticEuler,  // u += a(x, u) dt, then x += u dt
   kExplicitEuler,    // x and u both advanced with the old state
 };
