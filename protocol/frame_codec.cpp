@@ -249,11 +249,10 @@ Frame encode_welcome(const WelcomeInfo& info) {
   const auto kinds_offset = b.CreateVectorOfStructs(kinds);
   const auto policy = b.CreateString(info.control_policy);
   const wire::Vec3f tank_min = to_wire(info.tank.min), tank_max = to_wire(info.tank.max);
-  return finish(
-      b, wire::CreateWelcome(b, kProtocolVersion, info.client_id, variant, simd, info.worker_threads, &tank_min,
-                             &tank_max, info.dt, kinds_offset, info.player_id.has_value(), info.player_id.value_or(0),
-                             info.snapshot_rate_hz, policy, info.may_control, info.steps_per_contact, info.tolerance,
-                             info.observers_may_control));
+  return finish(b, wire::CreateWelcome(b, kProtocolVersion, info.client_id, variant, simd, info.worker_threads,
+                                       &tank_min, &tank_max, info.dt, kinds_offset, info.player_id.has_value(),
+                                       info.player_id.value_or(0), info.snapshot_rate_hz, policy, info.may_control,
+                                       info.steps_per_contact, info.tolerance, info.observers_may_control));
 }
 
 Frame encode_ball_kinds(std::uint32_t first_new_ball, const std::uint8_t* kinds, std::size_t count) {

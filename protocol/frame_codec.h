@@ -80,10 +80,10 @@ struct WelcomeInfo {
   float dt = 0.0f;
   std::optional<std::uint32_t> player_id;  // empty: the client observes
   float snapshot_rate_hz = 0.0f;
-  std::string control_policy;      // who may pause, step, reset and set the time scale, in words
-  bool may_control = false;        // whether this client may
-  float steps_per_contact = 0.0f;  // contact duration of the lightest pair / dt
-  float tolerance = 0.0f;          // the per-collision error dt was chosen for; 0: dt given
+  std::string control_policy;          // who may pause, step, reset and set the time scale, in words
+  bool may_control = false;            // whether this client may
+  float steps_per_contact = 0.0f;      // contact duration of the lightest pair / dt
+  float tolerance = 0.0f;              // the per-collision error dt was chosen for; 0: dt given
   bool observers_may_control = false;  // whether a client without a player sphere may
 };
 Frame encode_welcome(const WelcomeInfo& info);

@@ -435,11 +435,11 @@ TEST_CASE("a link found queueing is let drain kProbeInterval after a snapshot la
   fast.expect_acks();
   fast.sent(1, t0, 10'000);
   fast.acknowledged(1, false, t0 + milliseconds(10));
-  for (std::uint32_t tick = 2; tick < 1000; ++tick) {
-    const auto now = t0 + milliseconds(10 * tick);
-    REQUIRE(fast.may_send(now));
-    fast.sent(tick, now, 10'000);
-    if (tick > 2) fast.acknowledged(tick - 1, false, now + milliseconds(1));  // always one out
+  for (std::uint32_t fast_tick = 2; fast_tick < 1000; ++fast_tick) {
+    const auto at = t0 + milliseconds(10 * fast_tick);
+    REQUIRE(fast.may_send(at));
+    fast.sent(fast_tick, at, 10'000);
+    if (fast_tick > 2) fast.acknowledged(fast_tick - 1, false, at + milliseconds(1));  // always one out
   }
 }
 

@@ -100,10 +100,10 @@ void NetClient::do_connect() {
       host_, port_, [this, gen](error_code ec, const tcp::resolver::results_type& results) {
         if (gen != generation_) return;
         if (ec) return lose(cannot_resolve_text(host_, ec.message()));
-        asio::async_connect(socket_, results, [this, gen](error_code ec, const tcp::endpoint&) {
+        asio::async_connect(socket_, results, [this, gen](error_code connect_ec, const tcp::endpoint&) {
           if (gen != generation_) return;
-          if (ec) return lose("cannot connect: " + ec.message());
-          socket_.set_option(tcp::no_delay(true), ec);  // small inputs go out at once
+          if (connect_ec) return lose("cannot connect: " + connect_ec.message());
+          socket_.set_option(tcp::no_delay(true), connect_ec);  // small inputs go out at once
           send(protocol::encode_hello("fishtank-viewer", wants_player_, /*acknowledges=*/true));
           do_read_prefix();
         });
