@@ -2,7 +2,7 @@
 // Floating-point environment shared by both variants.
 //
 // A settled pile is full of tiny velocities and forces whose products fall
-// into the denormal range, where x86 arithmetic is ~100x slower. Physics never
+// into the denormal range, where x86 arithmetic is many times slower. Physics never
 // needs values below 1e-38, so every thread that steps the world flushes
 // denormals to zero (FTZ) and treats denormal inputs as zero (DAZ). This is a
 // property of the thread's MXCSR register, used by scalar and SSE float code

@@ -12,7 +12,8 @@ using Clock = std::chrono::steady_clock;
 // the budget); past it the loop lets simulated time slip: slow motion.
 constexpr double kMaxLagSeconds = 0.05;
 // How long before a batch the workers are woken: enough for a sleeping thread
-// to be scheduled, well inside the pool's 1 ms of polling.
+// to be scheduled, well inside the time the pool's workers poll before they
+// sleep (worker_pool.cpp's kWorkerSpin).
 constexpr double kWakeLeadSeconds = 0.0003;
 
 // The rates snapshots carry are measured over at most this long, whatever the

@@ -10,7 +10,7 @@
 //                                  per repetition so all sizes advance through
 //                                  the same stretch of simulated time
 //
-// A shared virtual machine's speed drifts by tens of percent over minutes.
+// A shared virtual machine's speed drifts over minutes.
 // Run with random interleaving and repetitions so every case samples the same
 // drift, and compare medians; --benchmark_filter=step_tank or step_wide picks
 // a family (the wide worlds take a few minutes to build). The run also says

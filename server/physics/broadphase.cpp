@@ -119,7 +119,7 @@ bool NeighbourList::misses_contact(std::uint32_t i, const Float4* pos, const Flo
 ListBuild NeighbourList::build_view(const Float4* pos, std::uint32_t n) {
   listed_balls_ = n;
   // The SIMD builds test four or eight consecutive candidates with one load
-  // per axis; a copy costs a fraction of a percent of the build.
+  // per axis, so they read the positions copied axis by axis.
   const std::size_t len = n + kGhostSlots;
   float *x = nullptr, *y = nullptr, *z = nullptr, *r = nullptr;
   if (lanes_ > 1) {

@@ -14,7 +14,8 @@
 //                  (and vel_half becomes vel_half_before)
 //   players move   (serial, few)
 //   rebuild?       if a ball strayed > skin/2 and the lists miss one of its
-//                  contacts (or checking costs more): sort by cell, reorder, new lists
+//                  contacts (or checking costs more), or the lists outlast their
+//                  cost: adapt the skin, sort by cell, reorder, new lists
 //   step pass    ║ parallel over balls (kernels.h): a = F/m + g, v = v_half + a dt/2,
 //                  then the next half kick and drift into pos_next, vel_half_next
 //
@@ -184,8 +185,9 @@ class World {
   StepContext context();
   // Whether the SIMD step asks for rows ahead (PrefetchPlan): from kBeyondCacheBalls balls.
   bool beyond_cache() const { return n_ >= kBeyondCacheBalls; }
-  // Tunable: about where the step's arrays (some 140 bytes a ball) outgrow second-level caches; below
-  // it, asking ahead costs instructions and buys nothing.
+  // Tunable, not read from the machine: at some 140 bytes a ball the step's arrays (4.5 MiB here)
+  // outgrow a core's private caches and its share of the last level; below it, asking ahead costs
+  // instructions and buys nothing.
   static constexpr std::uint32_t kBeyondCacheBalls = 32768;
   void derive_velocities() const;
 
