@@ -1,7 +1,7 @@
 #pragma once
-// One ball's hot data in one 16-byte slot: position + radius, velocity + mass,
-// acceleration + 0. A neighbour is then fetched with a single aligned load in
-// the SSE kernels, and read field by field in the scalar ones.
+// One ball's hot data in one 16-byte slot: position + radius, or velocity +
+// inverse mass (kernels.h's rows). A neighbour's row is then a single aligned
+// load in the SIMD kernels, and read field by field in the scalar one.
 
 #include <cstddef>
 #include <cstdlib>
@@ -18,12 +18,15 @@ static_assert(sizeof(Float4) == 16 && alignof(Float4) == 16);
 // The squared length of x, y, z: a velocity row's squared speed.
 inline float squared_length3(const Float4& v) { return v.x * v.x + v.y * v.y + v.z * v.z; }
 
+// Every x86-64 processor's cache line.
+inline constexpr std::size_t kCacheLineBytes = 64;
+
 // Cache-line aligned storage, so a thread's chunk never starts mid-line and the
 // arrays never share a line with unrelated data.
 template <class T>
 struct CacheAlignedAllocator {
   using value_type = T;
-  static constexpr std::size_t kAlignment = 64;
+  static constexpr std::size_t kAlignment = kCacheLineBytes;
   CacheAlignedAllocator() = default;
   template <class U>
   CacheAlignedAllocator(const CacheAlignedAllocator<U>&) {}

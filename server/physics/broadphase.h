@@ -92,7 +92,7 @@ struct BatchReach {
 // per cache line, up to kMost; past that a row is only fetched late.
 struct RemoteRows {
   static constexpr std::uint32_t kMost = 31;
-  static constexpr std::uint32_t kRowsPerLine = 64 / sizeof(Float4);
+  static constexpr std::uint32_t kRowsPerLine = kCacheLineBytes / sizeof(Float4);
   std::uint32_t count = 0;
   std::uint32_t rows[kMost];  // the first row of each line
 

@@ -297,6 +297,14 @@ template <class V>
   return c;
 }
 
+// Adds a force of magnitude f_over_dist · |d| along -d, pushing each lane's ball away from what it touches.
+template <class V>
+[[gnu::always_inline]] inline void push_apart(V f_over_dist, V dx, V dy, V dz, V& fx, V& fy, V& fz) {
+  fx = neg_mul_add(f_over_dist, dx, fx);
+  fy = neg_mul_add(f_over_dist, dy, fy);
+  fz = neg_mul_add(f_over_dist, dz, fz);
+}
+
 // Sum over each lane's neighbours of the contact force, into fx, fy, fz, in
 // list order as in the scalar twin (deferred lanes after the rest). Most
 // contacts last the whole step (or are none): their law is whole_or_no_contact_force,
@@ -340,10 +348,7 @@ template <bool kBranchFree, class V>
       f = select(whole_law, V::zero(), f);
       *deferred++ = {block, share};
     }
-    const V f_over_dist = f * p.inv_dist;
-    fx = neg_mul_add(f_over_dist, dx, fx);
-    fy = neg_mul_add(f_over_dist, dy, fy);
-    fz = neg_mul_add(f_over_dist, dz, fz);
+    push_apart(f * p.inv_dist, dx, dy, dz, fx, fy, fz);
   }
 }
 
@@ -363,9 +368,7 @@ template <class V>
   const auto lanes = (d2 < reach_lead * reach_lead) & needs_whole_law(m, p.overlap, p.v_n, v_before);
   const V f_over_dist =
       keep(lanes, normal_force(m, p.overlap, p.v_n, pair_c(i, p.inv_mj), i.inv_m + p.inv_mj, v_before)) * p.inv_dist;
-  f[0] = neg_mul_add(f_over_dist, dx, f[0]);
-  f[1] = neg_mul_add(f_over_dist, dy, f[1]);
-  f[2] = neg_mul_add(f_over_dist, dz, f[2]);
+  push_apart(f_over_dist, dx, dy, dz, f[0], f[1], f[2]);
 }
 
 // One axis of the six half-space walls: below the minimum face the force
@@ -417,9 +420,7 @@ template <class V>
           ((V::splat(vj.x) - i.bx) * dx + (V::splat(vj.y) - i.by) * dy + (V::splat(vj.z) - i.bz) * dz) * inv_dist;
       const V f_over_dist =
           keep(near, normal_force(m, r + V::splat(pj.w) - dist, v_n, d.c, i.inv_m, v_n_before) * inv_dist);
-      fx = neg_mul_add(f_over_dist, dx, fx);
-      fy = neg_mul_add(f_over_dist, dy, fy);
-      fz = neg_mul_add(f_over_dist, dz, fz);
+      push_apart(f_over_dist, dx, dy, dz, fx, fy, fz);
     }
     if (walls) {  // an axis no lane is near adds zero
       if (simd::any(near_x)) fx += wall_force(m, d, i.inv_m, i.x, i.vx, i.bx, r, t.min.x, t.max.x);
@@ -431,8 +432,6 @@ template <class V>
   fy = fy * i.inv_m - V::splat(m.gravity);
   fz = fz * i.inv_m;
 }
-
-constexpr std::size_t kCacheLine = 64;
 
 // Lines read again by later groups (a batch's rows are its neighbours'
 // neighbours) or touched once this step (records, lists, next-step rows): the
@@ -447,6 +446,13 @@ inline void prefetch(const void* base, std::size_t bytes) {
   __builtin_prefetch(reinterpret_cast<const void*>(reinterpret_cast<std::uintptr_t>(base) + bytes), 0, kLocality);
 }
 
+// The rows a ball's neighbours read (position, half-step velocity now and a step before), `bytes` in.
+inline void prefetch_rows(const StepArrays& s, std::size_t bytes) {
+  prefetch<Reuse::kAgain>(s.pos, bytes);
+  prefetch<Reuse::kAgain>(s.vel_half, bytes);
+  prefetch<Reuse::kAgain>(s.vel_half_before, bytes);
+}
+
 // This group's share of the rows, records and lists of the batch
 // kPrefetchBatches ahead, and of that batch's remote rows.
 template <std::uint32_t kCount>
@@ -456,26 +462,23 @@ template <std::uint32_t kCount>
   const PrefetchPlan& plan = ctx.plan;
   const std::size_t ahead = std::size_t(batch) + kPrefetchBatches * kStepBatch;
   const std::size_t rows = (ahead + share * kCount) * sizeof(Float4);
-  for (std::size_t line = rows; line < rows + kCount * sizeof(Float4); line += kCacheLine) {
-    prefetch<Reuse::kAgain>(s.pos, line);
-    prefetch<Reuse::kAgain>(s.vel_half, line);
-    prefetch<Reuse::kAgain>(s.vel_half_before, line);
+  for (std::size_t line = rows; line < rows + kCount * sizeof(Float4); line += kCacheLineBytes) {
+    prefetch_rows(s, line);
     prefetch<Reuse::kOnce>(lists.records, line);  // 16 bytes per ball too, in the batch's group order
     prefetch<Reuse::kOnce>(s.pos_next, line);
     prefetch<Reuse::kOnce>(s.vel_half_next, line);
   }
-  // A group's blocks take about eight entries (32 bytes) per lane.
+  // A group's blocks take about eight entries per lane (a settled pile's neighbours, rounded up to a block).
+  constexpr std::size_t kListBytesPerLane = 8 * sizeof(std::uint32_t);
   const std::size_t block = ahead * lists.stride * sizeof(std::uint32_t);
-  for (std::size_t line = share * kCount * 32; line < (share + 1) * kCount * 32; line += kCacheLine)
+  for (std::size_t line = share * kCount * kListBytesPerLane; line < (share + 1) * kCount * kListBytesPerLane;
+       line += kCacheLineBytes)
     prefetch<Reuse::kOnce>(lists.neighbours, block + line);
   const std::size_t remote_batch = ahead / kStepBatch;
   if (remote_batch >= plan.batches) return;
   const RemoteRows& remote = plan.remote_rows[remote_batch];
-  for (std::uint32_t k = share; k < remote.count; k += kStepBatch / kCount) {
-    prefetch<Reuse::kAgain>(s.pos, std::size_t(remote.rows[k]) * sizeof(Float4));
-    prefetch<Reuse::kAgain>(s.vel_half, std::size_t(remote.rows[k]) * sizeof(Float4));
-    prefetch<Reuse::kAgain>(s.vel_half_before, std::size_t(remote.rows[k]) * sizeof(Float4));
-  }
+  for (std::uint32_t k = share; k < remote.count; k += kStepBatch / kCount)
+    prefetch_rows(s, std::size_t(remote.rows[k]) * sizeof(Float4));
 }
 
 inline bool in_window(const RowFetch& f, std::uint32_t batch) { return batch >= f.first_batch && batch < f.end_batch; }
@@ -487,16 +490,13 @@ template <std::uint32_t kCount>
                                               std::uint32_t share) {
   if (!in_window(f, batch)) return;
   constexpr std::size_t kGroups = kStepBatch / kCount;
-  const std::size_t first_line = f.rows_begin * sizeof(Float4) / kCacheLine;
-  const std::size_t end_line = (f.rows_end * sizeof(Float4) + kCacheLine - 1) / kCacheLine;
+  const std::size_t first_line = f.rows_begin * sizeof(Float4) / kCacheLineBytes;
+  const std::size_t end_line = (f.rows_end * sizeof(Float4) + kCacheLineBytes - 1) / kCacheLineBytes;
   const std::size_t groups = (f.end_batch - f.first_batch) * kGroups;
   const std::size_t per_group = (end_line - first_line + groups - 1) / groups;
   const std::size_t from = first_line + ((batch - f.first_batch) * kGroups + share) * per_group;
-  for (std::size_t line = from; line < std::min(end_line, from + per_group); ++line) {
-    prefetch<Reuse::kAgain>(s.pos, line * kCacheLine);
-    prefetch<Reuse::kAgain>(s.vel_half, line * kCacheLine);
-    prefetch<Reuse::kAgain>(s.vel_half_before, line * kCacheLine);
-  }
+  for (std::size_t line = from; line < std::min(end_line, from + per_group); ++line)
+    prefetch_rows(s, line * kCacheLineBytes);
 }
 
 // A batch's groups, one ball per lane: a = F / m + g, then per_group(at, i, ax, ay, az, record)
