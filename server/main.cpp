@@ -172,8 +172,7 @@ fishtank::net::ServerInfo server_info(const fishtank::World& world, const fishta
   info.tank = world.params().tank;
   info.dt = world.dt();
   info.steps_per_contact = fishtank::contact_duration(o.physics.stiffness) / world.dt();
-  const bool from_tolerance = o.physics.dt <= 0.0f && o.physics.steps_per_contact <= 0;
-  info.tolerance = from_tolerance ? o.physics.tolerance : 0.0f;
+  info.tolerance = fishtank::dt_from_tolerance(o.physics) ? o.physics.tolerance : 0.0f;
   info.snapshot_rate_hz = static_cast<float>(o.snapshot_rate);
   info.control = o.control;
   info.limits = o.limits;

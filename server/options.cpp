@@ -35,6 +35,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   std::int64_t balls = 0, steps = static_cast<std::int64_t>(o.bench_spec.steps);
   std::int64_t threads = threaded ? WorkerPool::hardware_threads() : 1, max_balls = 0, seed = 1;
   std::int64_t steps_per_contact = defaults.steps_per_contact;
+  double dt = defaults.dt;  // read wide: a float would take 1e-46 as 0 (automatic) without a word
   double settle_time = 0.0;
   std::int64_t windows = o.bench_spec.windows;
 
@@ -133,7 +134,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "largest per-collision restitution error allowed, [0.002, 0.0075]: sets the steps per contact")(
       "steps-per-contact", po::value(&steps_per_contact)->default_value(steps_per_contact),
       "automatic dt = contact duration / this (>= 10; 0: from --tolerance)")(
-      "dt", po::value(&o.physics.dt)->default_value(0.0), "fixed time step in seconds (0: automatic)")(
+      "dt", po::value(&dt)->default_value(0.0), "fixed time step in seconds, t_c / 100000 to t_c / 10 (0: automatic)")(
       "skin", po::value(&o.physics.skin)->default_value(defaults.skin, "0"),
       "neighbour-list skin, units, up to 10 (0: follows the motion, 0.1-1)");
 
@@ -232,10 +233,17 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
     return fail("--status-interval must be between 0.05 and 3600 seconds, got " + number_text(o.status_interval));
   if (!std::isfinite(settle_time) || settle_time < 0.0 || settle_time > 1e6)
     return fail("--settle-time must be between 0 and 1e6 simulated seconds, got " + number_text(settle_time));
-  if (steps_per_contact != 0 && (steps_per_contact < PhysicsParams::kMinStepsPerContact || steps_per_contact > 100000))
+  if (steps_per_contact != 0 && (steps_per_contact < PhysicsParams::kMinStepsPerContact ||
+                                 steps_per_contact > PhysicsParams::kMaxStepsPerContact))
     return fail("--steps-per-contact must be 0 (from --tolerance) or between " +
-                std::to_string(PhysicsParams::kMinStepsPerContact) + " and 100000, got " +
-                std::to_string(steps_per_contact));
+                std::to_string(PhysicsParams::kMinStepsPerContact) + " and " +
+                std::to_string(PhysicsParams::kMaxStepsPerContact) + ", got " + std::to_string(steps_per_contact));
+  if (dt > 0.0 && dt < double(shortest_dt(o.physics.stiffness)))
+    return fail("--dt " + number_text(dt) + " is too short for k = " + number_text(o.physics.stiffness) +
+                " N/m: at most " + std::to_string(PhysicsParams::kMaxStepsPerContact) +
+                " steps per contact, so at least " + number_text(shortest_dt(o.physics.stiffness)) +
+                " s (or 0 for automatic)");
+  o.physics.dt = static_cast<float>(dt);
 
   // Each sets the time step: of two, one would go unused without a word.
   std::vector<std::string> step_flags;

@@ -32,13 +32,15 @@ struct PhysicsParams {
   float restitution = 0.6f;        // e, measured rebound / approach normal speed
   float tolerance = 0.005f;        // largest per-collision restitution error: sets n
   int steps_per_contact = 0;       // n in dt = t_c / n; 0: from the tolerance
-  float dt = 0.0f;                 // 0: derive from k; otherwise must be <= t_c / kMinStepsPerContact
+  float dt = 0.0f;                 // 0: derive from k; otherwise t_c / kMaxStepsPerContact ... t_c / kMinStepsPerContact
   float skin = 0.0f;               // neighbour-list skin, units; 0: follows the motion (World::adapt_skin)
   float gravity = 9.81f;           // m/s^2, along -y
   float player_max_speed = 10.0f;  // m/s; faster commands are clamped
   TankBounds tank;
 
   static constexpr int kMinStepsPerContact = 10;
+  // Past this, a slow ball's step moves it less than float32 positions resolve.
+  static constexpr int kMaxStepsPerContact = 100000;
   static constexpr float kToleranceRule = 0.8f;        // worst error times n^2, at most
   static constexpr float kTightestTolerance = 0.002f;  // float32 positions floor for a 0.1 m/s contact
   static constexpr float kLoosestTolerance = 0.0075f;  // 11 steps: the rule's margin over kMinStepsPerContact
@@ -65,8 +67,10 @@ struct ContactModel {
 float damping_ratio(float restitution);
 float smallest_effective_mass();
 float contact_duration(float stiffness);
+float shortest_dt(float stiffness);  // t_c / kMaxStepsPerContact
 int steps_for_tolerance(float tolerance);
 int steps_per_contact(const PhysicsParams& p);  // given, or from the tolerance
+bool dt_from_tolerance(const PhysicsParams& p);  // neither dt nor steps per contact given
 float derived_dt(const PhysicsParams& p);
 inline float starting_skin(const PhysicsParams& p) { return p.skin > 0.0f ? p.skin : PhysicsParams::kStartSkin; }
 // The softest k the tank's gravity allows: a column of the heaviest balls as

@@ -51,6 +51,8 @@ TEST_CASE("unstable or absurd parameters are refused with a reason", "[params]")
     CHECK(why.find("at least 784.8 N/m") != std::string::npos);
     p.stiffness = softest_stiffness(p);
     CHECK(validate(p).empty());
+    p.stiffness = 784.8f;  // the floor as the message and --help print it
+    CHECK(validate(p).empty());
   }
   SECTION("stiffness below 1 N/m, even without gravity") {
     p.gravity = 0.0f;

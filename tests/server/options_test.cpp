@@ -193,6 +193,10 @@ TEST_CASE("every bad value is refused with a message naming it and exit code 2",
       {{"--tolerance", "0.0001"}, "float32 positions cannot resolve a slow contact"},
       {{"--tolerance", "nan"}, "tolerance must be in [0.002, 0.0075]"},
       {{"--dt", "0.01"}, "unstable for k"},
+      // Below t_c / 100000, and where a float would read it as 0 (automatic) or a denormal.
+      {{"--dt", "1e-8"}, "--dt 1e-08 is too short for k = 25000 N/m: at most 100000 steps per contact, so at least"},
+      {{"--dt", "1e-40"}, "--dt 1e-40 is too short"},
+      {{"--dt", "1e-46"}, "--dt 1e-46 is too short"},
       {{"--tolerance", "0.002", "--steps-per-contact", "15"},
        "--tolerance, --steps-per-contact and --dt each set the time step; give one of them, got --tolerance 0.002 "
        "and --steps-per-contact 15"},
@@ -236,6 +240,14 @@ TEST_CASE("every bad value is refused with a message naming it and exit code 2",
     CHECK(r.message.find(b.says) != std::string::npos);
     CHECK(r.message.rfind("fishtank-server: ", 0) == 0);
   }
+}
+
+TEST_CASE("the range ends the refusals state are accepted: k 784.8 and dt t_c / 100000", "[options]") {
+  CHECK(parse({"--stiffness", "784.8"}).options);
+  const ParseResult shortest = parse({"--dt", "1.41e-7"});  // t_c / 100000 = 1.405e-7 s at the default k
+  REQUIRE(shortest.options);
+  CHECK(shortest.options->physics.dt == 1.41e-7f);
+  CHECK(parse({"--dt", "0"}).options->physics.dt == 0.0f);  // automatic
 }
 
 TEST_CASE("the scalar build refuses more than one thread and says which build to use", "[options]") {
