@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "client/connection.h"
+#include "common/number_text.h"
 #include "common/server_hint.h"
 
 namespace fishtank::client {
@@ -65,8 +66,8 @@ Summary summarise(const std::vector<std::shared_ptr<Connection>>& connections, d
       s.steps_per_s = c->view().steps_per_s;
       s.load = c->view().load;
       s.threads_stepping = c->view().threads_stepping;
-      s.time_scale = c->view().time_scale;
-      s.time_scale_set = c->view().time_scale_set;
+      s.time_scale = shortest_decimal(c->view().time_scale);  // 0.1 as set, not the float widened
+      s.time_scale_set = shortest_decimal(c->view().time_scale_set);
       s.max_overlap = c->view().max_overlap;
       s.paused = c->view().paused;
       s.scene = c->view().scene;

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <vector>
 
+#include "common/number_text.h"
 #include "server/bench/line_transfer.h"
 #include "server/physics/world_measures.h"
 
@@ -79,11 +80,14 @@ nlohmann::json time_steps(TunedStepper& stepper, const BenchSpec& spec, const Se
   j["dt"] = world.dt();
   // Balls this build holds in real time at this dt: ball-steps per second times simulated seconds per step.
   j["realtime_capacity_balls"] = median_rate * world.dt();
-  j["tolerance"] = world.params().tolerance;  // per-collision restitution error the dt was chosen for
-  j["steps_per_contact"] = steps_per_contact(world.params());
-  j["dt_from_tolerance"] = world.params().steps_per_contact == 0 && world.params().dt == 0.0f;
-  j["k"] = world.params().stiffness;
-  j["restitution"] = world.params().restitution;
+  const PhysicsParams& params = world.params();
+  // The per-collision restitution error the dt was chosen for; none where --dt or --steps-per-contact chose it.
+  j["tolerance"] = dt_from_tolerance(params) ? nlohmann::json(shortest_decimal(params.tolerance)) : nullptr;
+  j["steps_per_contact"] = params.dt > 0.0f ? nlohmann::json(contact_duration(params.stiffness) / world.dt())
+                                            : nlohmann::json(steps_per_contact(params));
+  j["dt_from_tolerance"] = dt_from_tolerance(params);
+  j["k"] = shortest_decimal(params.stiffness);
+  j["restitution"] = shortest_decimal(params.restitution);
   j["max_overlap"] = max_overlap_fraction(world);
   j["overlap_warning"] = overlap_warning(world);  // empty while the largest overlap is within kOverlapWarning
   j["pile_top"] = pile_top(world);

@@ -122,3 +122,35 @@ TEST_CASE("a world of too few balls to split steps on one thread and says so, mo
     if (!split) CHECK(j["thread_shares"][1].get<double>() == 0.0);
   }
 }
+
+TEST_CASE("the report states the tolerance only where it chose dt, and the steps per contact dt gives", "[bench]") {
+  BenchSpec spec;
+  spec.scene.balls = 100;
+  spec.steps = 4;
+  spec.windows = 1;
+  const auto report = [&](PhysicsParams params) {
+    World world(params, kScalarKernels, 1, spec.scene.seed);
+    REQUIRE(populate(world, spec.scene).empty());
+    TunedStepper stepper(world, false);
+    return time_steps(stepper, spec, SettleReport{});
+  };
+  const nlohmann::json chosen = report(PhysicsParams{});
+  CHECK(chosen["tolerance"].dump() == "0.005");  // as given, not the float widened to 0.004999999888...
+  CHECK(chosen["restitution"].dump() == "0.6");
+  CHECK(chosen["steps_per_contact"] == 13);
+  CHECK(chosen["dt_from_tolerance"] == true);
+
+  PhysicsParams given_n;
+  given_n.steps_per_contact = 20;
+  const nlohmann::json by_n = report(given_n);
+  CHECK(by_n["tolerance"].is_null());
+  CHECK(by_n["steps_per_contact"] == 20);
+  CHECK(by_n["dt_from_tolerance"] == false);
+
+  PhysicsParams given_dt;
+  given_dt.dt = 5e-4f;
+  const nlohmann::json by_dt = report(given_dt);
+  CHECK(by_dt["tolerance"].is_null());
+  CHECK(by_dt["steps_per_contact"].get<double>() == Approx(contact_duration(given_dt.stiffness) / 5e-4));
+  CHECK(by_dt["dt"].get<double>() == Approx(5e-4));
+}
