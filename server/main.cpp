@@ -145,7 +145,7 @@ std::string pace_text(const fishtank::LoopStatus& s, const fishtank::RunControl&
   char text[64] = "";
   if (control.time_scale < 1.0) std::snprintf(text, sizeof text, "  time scale set to x%.2f", control.time_scale);
   std::string pace = text;
-  if (fishtank::slow_motion(s.time_scale, control.time_scale)) {
+  if (fishtank::slow_motion(s.pace_kept)) {
     std::snprintf(text, sizeof text, "  slow motion x%.2f", s.time_scale);
     return pace + text;
   }

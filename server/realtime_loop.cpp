@@ -30,35 +30,41 @@ double seconds_between(Clock::time_point from, Clock::time_point to) {
 // Steps and busy time since `start`, turned into a status's rates once `length` has passed.
 // Its times are when steps fell due (the loop's sim_clock), not when they ran: a window
 // ended between steps far apart, or at a step woken late, would count a step short and
-// read as slow motion. Only time dropped while behind lowers the time scale.
+// read as slow motion. Only time dropped while behind lowers the time scale. The busy
+// share is of the wall clock's time (wall_start), which a machine behind runs ahead of.
 // The simulated seconds people asked for are summed too (none while paused), so that a
 // window in which they paused, resumed or set another time scale is not read as slow motion.
 struct RateWindow {
   double start;
+  double wall_start;
   double length;
   double first_length = 0.0;  // above 0: this window ends after that instead (restart)
   std::uint64_t steps = 0;
   double busy = 0.0;
-  double asked = 0.0;  // simulated seconds the time scale set asked for
+  double running = 0.0;  // of the window's time, that not paused
+  double asked = 0.0;    // simulated seconds the time scale set asked for
 
-  void add(std::uint64_t batch_steps, double batch_busy, double asked_seconds) {
+  void add(std::uint64_t batch_steps, double batch_busy, double running_seconds, double asked_seconds) {
     steps += batch_steps;
     busy += batch_busy;
+    running += running_seconds;
     asked += asked_seconds;
   }
-  // Whether it has ended at `end`; then its rates are written into status and it starts again. The time
-  // scale is the share of the asked time achieved, times the scale asked now (scale_now): where the scale
-  // asked did not change, simulated seconds per wall second.
-  bool close(double end, double dt, double scale_now, LoopStatus& status) {
+  // Whether it has ended at `end` (wall_end on the wall clock); then its rates are written into status
+  // and it starts again.
+  bool close(double end, double wall_end, double dt, LoopStatus& status) {
     const double span = end - start;
     if (span < (first_length > 0.0 ? first_length : length)) return false;
     status.steps_per_s = steps / span;
-    status.load = busy / span;
-    status.time_scale = asked > 0.0 && scale_now > 0.0 ? steps * dt / asked * scale_now : steps * dt / span;
-    *this = {end, length};
+    status.load = busy / std::max(wall_end - wall_start, busy);
+    status.time_scale = steps * dt / (running > 0.0 ? running : span);
+    status.pace_kept = asked > 0.0 ? steps * dt / asked : 1.0;
+    *this = {end, wall_end, length};
     return true;
   }
-  void restart(double at, double ends_after) { *this = {at, length, std::min(ends_after, length)}; }
+  void restart(double at, double wall_at, double ends_after) {
+    *this = {at, wall_at, length, std::min(ends_after, length)};
+  }
 };
 }  // namespace
 
@@ -96,8 +102,8 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
   const Clock::time_point start = Clock::now();
   double sim_clock = 0.0;  // the wall time by which the steps done so far were due
   LoopStatus status;       // what at_step_boundary sees: rates of the latest live window
-  RateWindow live{0.0, std::min(options.status_interval, kLiveWindowSeconds)};
-  RateWindow line{0.0, options.status_interval};
+  RateWindow live{0.0, 0.0, std::min(options.status_interval, kLiveWindowSeconds)};
+  RateWindow line{0.0, 0.0, options.status_interval};
   bool paused_was = control.paused;
   double scale_was = control.time_scale;
 
@@ -108,7 +114,7 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
     const double clock_before = sim_clock;
     if (options.at_step_boundary) options.at_step_boundary(world, status);
     if (control.paused != paused_was || control.time_scale != scale_was) {
-      live.restart(clock_before, kWindowAfterChangeSeconds);
+      live.restart(clock_before, now, kWindowAfterChangeSeconds);
       paused_was = control.paused;
       scale_was = control.time_scale;
     }
@@ -140,17 +146,16 @@ void run_realtime(TunedStepper& stepper, const LoopOptions& options, const std::
         stepper.step();
     }
     const Clock::time_point busy_end = Clock::now();
-    const double busy = seconds_between(busy_start, busy_end);
+    const double busy = seconds_between(busy_start, busy_end), wall_end = seconds_between(start, busy_end);
     // The wall time this round covered, at the scale asked in it (set by at_step_boundary, before the batch).
-    const double scale_asked = control.paused ? 0.0 : control.time_scale;
-    const double asked = (sim_clock - clock_before) * scale_asked;
-    live.add(batch_steps, busy, asked);
-    line.add(batch_steps, busy, asked);
+    const double running = control.paused ? 0.0 : sim_clock - clock_before;
+    live.add(batch_steps, busy, running, running * control.time_scale);
+    line.add(batch_steps, busy, running, running * control.time_scale);
     status.threads = stepper.threads();
     status.crowding_cores = stepper.crowding_cores();
-    live.close(sim_clock, dt, scale_asked, status);
+    live.close(sim_clock, wall_end, dt, status);
     LoopStatus line_status = status;
-    if (line.close(sim_clock, dt, scale_asked, line_status)) {
+    if (line.close(sim_clock, wall_end, dt, line_status)) {
       if (options.on_status) options.on_status(world, line_status);
       status.dropped_steps = 0;
     }

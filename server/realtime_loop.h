@@ -49,11 +49,14 @@ struct LoopStatus {
   double steps_per_s = 0.0;
   int threads = 1;                  // worker threads the steps use now (see ThreadTuner)
   double crowding_cores = -1.0;     // cores work in other sessions keeps busy; below 0 unknown
-  double load = 0.0;                // 0..1: time spent stepping / wall time
+  double load = 0.0;                // 0..1: time the loop spent stepping (and at its boundaries) / wall time
   std::uint64_t dropped_steps = 0;  // steps skipped because the machine fell behind, in the last interval
-  // Simulated seconds per wall second: below 1 the physics cannot keep real
-  // time and the world runs in slow motion.
+  // Simulated seconds per wall second while not paused: below the scale people
+  // asked for, the physics cannot keep up and the world runs in slow motion.
   double time_scale = 1.0;
+  // Simulated time done / asked for (1: none asked, paused): below 1 it fell short,
+  // also where the scale asked changed within the window.
+  double pace_kept = 1.0;
 };
 
 // What people ask of the loop: pause, a few steps while paused, a slower
