@@ -16,7 +16,7 @@ Connection::Connection(asio::io_context& io, std::string name, bool wants_player
 
 void Connection::start(const asio::ip::tcp::endpoint& server, std::uint32_t version) {
   socket_.async_connect(server, [this, self = shared_from_this(), version](boost::system::error_code ec) {
-    if (ec) return fail("cannot connect: " + ec.message());
+    if (ec) return fail(ec == asio::error::operation_aborted ? "" : "cannot connect: " + ec.message());
     boost::system::error_code ignored;
     socket_.set_option(asio::ip::tcp::no_delay(true), ignored);
     send(protocol::encode_hello(name_, wants_player_, acknowledge_, version));
@@ -68,6 +68,7 @@ void Connection::do_read() {
       read_rate_ > 0.0 ? std::clamp<std::size_t>(read_rate_ / 50.0, 1024, read_buffer_.size()) : read_buffer_.size();
   socket_.async_read_some(asio::buffer(read_buffer_.data(), chunk),
                           [this, self = shared_from_this()](boost::system::error_code ec, std::size_t n) {
+                            if (ec == asio::error::operation_aborted) return fail("");  // close()'s own
                             if (ec)
                               return fail(ec == asio::error::eof ? closed_by_server_text(farewell_) : ec.message());
                             stats_.bytes_received += n;
