@@ -108,8 +108,7 @@ Moved step(const StepContext& context, std::uint32_t begin, std::uint32_t end) {
       const Float4 v{vh.x + a.x * m.half_dt, vh.y + a.y * m.half_dt, vh.z + a.z * m.half_dt, vh.w};
       const float d2 = kick_drift(m, v, s.pos[i], a, lists.at_build[i], s.vel_half_next[i], s.pos_next[i]);
       moved.max_d2 = std::max(moved.max_d2, d2);
-      const Float4& vn = s.vel_half_next[i];
-      moved.max_v2 = std::max(moved.max_v2, vn.x * vn.x + vn.y * vn.y + vn.z * vn.z);
+      moved.max_v2 = std::max(moved.max_v2, squared_length3(s.vel_half_next[i]));
       if (d2 > s.stray_d2) s.stray_balls[begin + moved.strayed++] = i;
     }
   }

@@ -83,6 +83,23 @@ std::vector<double> measure_rates(Clients& clients, const std::vector<std::share
   return rates;
 }
 
+// `pings` Pings a quarter of a second apart from c, then a second for the last Pongs: the round trips, sorted.
+std::vector<double> ping_round_trips(Clients& clients, Connection& c, int pings) {
+  for (int ping = 0; ping < pings; ++ping) {
+    c.send_ping();
+    clients.run_for(std::chrono::milliseconds(250));
+  }
+  clients.run_for(std::chrono::milliseconds(1000));
+  std::vector<double> rtt = c.stats().rtt_ms;
+  std::sort(rtt.begin(), rtt.end());
+  return rtt;
+}
+
+std::string round_trips_text(const std::vector<double>& rtt, int pings) {
+  return std::to_string(rtt.size()) + " of " + std::to_string(pings) + " Pings answered; round trips " +
+         (rtt.empty() ? "none" : std::to_string(rtt.front()) + " .. " + std::to_string(rtt.back())) + " ms";
+}
+
 // The server's status lines ("t = ... s  balls ..."), oldest first.
 std::vector<std::string> status_lines(const ServerProcess& server) {
   std::vector<std::string> lines;
@@ -585,16 +602,8 @@ TEST_CASE("a client on a slow link gets fewer snapshots, not older ones: its pic
   auto slow = clients.add(false);
   slow->limit_read_rate(100e3);
   REQUIRE(clients.wait_until([&] { return slow->stats().snapshots > 0; }, std::chrono::seconds(10)));
-  for (int ping = 0; ping < 32; ++ping) {  // 8 s, from its first snapshot on
-    slow->send_ping();
-    clients.run_for(std::chrono::milliseconds(250));
-  }
-  clients.run_for(std::chrono::milliseconds(1000));  // the last Pongs come back
-  std::vector<double> rtt = slow->stats().rtt_ms;
-  std::sort(rtt.begin(), rtt.end());
-  INFO(rtt.size() << " of 32 Pings answered; round trips "
-                  << (rtt.empty() ? "none" : std::to_string(rtt.front()) + " .. " + std::to_string(rtt.back()))
-                  << " ms");
+  const std::vector<double> rtt = ping_round_trips(clients, *slow, 32);  // 8 s, from its first snapshot on
+  INFO(round_trips_text(rtt, 32));
   REQUIRE(rtt.size() >= 28);  // a Pong waits behind what the sockets queue
   CHECK(rtt[rtt.size() / 2] < 500.0);
   CHECK(rtt.back() < 1500.0);
@@ -612,16 +621,8 @@ TEST_CASE("a client joining a full tank over a slow link starts without a queue:
   auto slow = clients.add(false);
   slow->limit_read_rate(60e3);
   REQUIRE(clients.wait_until([&] { return slow->stats().snapshots > 0; }, std::chrono::seconds(10)));
-  for (int ping = 0; ping < 16; ++ping) {  // 4 s
-    slow->send_ping();
-    clients.run_for(std::chrono::milliseconds(250));
-  }
-  clients.run_for(std::chrono::milliseconds(1000));
-  std::vector<double> rtt = slow->stats().rtt_ms;
-  std::sort(rtt.begin(), rtt.end());
-  INFO(rtt.size() << " of 16 Pings answered; round trips "
-                  << (rtt.empty() ? "none" : std::to_string(rtt.front()) + " .. " + std::to_string(rtt.back()))
-                  << " ms; " << slow->stats().keyframes << " keyframes of " << slow->stats().snapshots);
+  const std::vector<double> rtt = ping_round_trips(clients, *slow, 16);  // 4 s
+  INFO(round_trips_text(rtt, 16) << "; " << slow->stats().keyframes << " keyframes of " << slow->stats().snapshots);
   REQUIRE(rtt.size() >= 14);
   CHECK(rtt.back() < 1500.0);
   CHECK(slow->stats().keyframes <= 2);

@@ -113,28 +113,27 @@ void SphereRenderer::upload(const SphereInstance* spheres, std::size_t count) {
   glBufferSubData(GL_ARRAY_BUFFER, 0, bytes, spheres);
 }
 
-void SphereRenderer::draw(const Mat4& view_proj, const std::vector<SphereInstance>& spheres) {
-  if (spheres.empty()) return;
+void SphereRenderer::prepare(const Mat4& view_proj, float grow, float depth_grow, bool unlit,
+                             const SphereInstance* spheres, std::size_t count) {
   glUseProgram(program_);
   glUniformMatrix4fv(u_view_proj_, 1, GL_FALSE, view_proj.data());
-  glUniform1f(u_grow_, 1.0f);
-  glUniform1f(u_depth_grow_, 1.0f);
-  glUniform1i(u_unlit_, GL_FALSE);
+  glUniform1f(u_grow_, grow);
+  glUniform1f(u_depth_grow_, depth_grow);
+  glUniform1i(u_unlit_, unlit ? GL_TRUE : GL_FALSE);
   glBindVertexArray(vao_);
-  upload(spheres.data(), spheres.size());
+  upload(spheres, count);
+}
+
+void SphereRenderer::draw(const Mat4& view_proj, const std::vector<SphereInstance>& spheres) {
+  if (spheres.empty()) return;
+  prepare(view_proj, 1.0f, 1.0f, false, spheres.data(), spheres.size());
   glDrawElementsInstanced(GL_TRIANGLES, index_count_, GL_UNSIGNED_SHORT, nullptr,
                           static_cast<GLsizei>(spheres.size()));
   glBindVertexArray(0);
 }
 
 void SphereRenderer::draw_outline(const Mat4& view_proj, const SphereInstance& sphere, float grow) {
-  glUseProgram(program_);
-  glUniformMatrix4fv(u_view_proj_, 1, GL_FALSE, view_proj.data());
-  glUniform1f(u_grow_, grow);
-  glUniform1f(u_depth_grow_, grow);
-  glUniform1i(u_unlit_, GL_TRUE);
-  glBindVertexArray(vao_);
-  upload(&sphere, 1);
+  prepare(view_proj, grow, grow, true, &sphere, 1);
   glCullFace(GL_FRONT);
   glDrawElementsInstanced(GL_TRIANGLES, index_count_, GL_UNSIGNED_SHORT, nullptr, 1);
   glCullFace(GL_BACK);
@@ -143,13 +142,7 @@ void SphereRenderer::draw_outline(const Mat4& view_proj, const SphereInstance& s
 
 void SphereRenderer::draw_hidden(const Mat4& view_proj, const SphereInstance& sphere, float grow,
                                  float alpha) {
-  glUseProgram(program_);
-  glUniformMatrix4fv(u_view_proj_, 1, GL_FALSE, view_proj.data());
-  glUniform1f(u_grow_, grow);
-  glUniform1f(u_depth_grow_, kHiddenDepthGrow);
-  glUniform1i(u_unlit_, GL_TRUE);
-  glBindVertexArray(vao_);
-  upload(&sphere, 1);
+  prepare(view_proj, grow, kHiddenDepthGrow, true, &sphere, 1);
   glDepthFunc(GL_GREATER);
   glDepthMask(GL_FALSE);
   glEnable(GL_BLEND);

@@ -30,6 +30,9 @@ class SphereRenderer {
   void draw_hidden(const Mat4& view_proj, const SphereInstance& sphere, float grow, float alpha);
 
  private:
+  // The program and its uniforms bound, and these spheres uploaded as the instances to draw.
+  void prepare(const Mat4& view_proj, float grow, float depth_grow, bool unlit, const SphereInstance* spheres,
+               std::size_t count);
   void upload(const SphereInstance* spheres, std::size_t count);
 
   GLuint program_ = 0;
