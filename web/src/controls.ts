@@ -9,7 +9,7 @@ import { TouchPad } from './touch_pad';
 import * as wire from './wire';
 
 // The scene presets in the order keys 1-4 choose them (common/scene_names.h).
-export const SCENE_NAMES = ['tank', 'wide', 'dam-break', 'drop'];
+const SCENE_NAMES = ['tank', 'wide', 'dam-break', 'drop'];
 // The time-scale ladder [ and ] move along (kTimeScaleLadder).
 const TIME_SCALE_LADDER = [0.1, 0.25, 0.5, 1];
 
@@ -31,7 +31,7 @@ const noActions = (): Actions => ({
 });
 
 // The next rung from `current` in `direction` (-1 slower, +1 faster), staying on the ladder's ends.
-export function nextTimeScale(current: number, direction: number): number {
+function nextTimeScale(current: number, direction: number): number {
   if (direction > 0) return TIME_SCALE_LADDER.find((r) => r > current * 1.001) ?? TIME_SCALE_LADDER[TIME_SCALE_LADDER.length - 1];
   return [...TIME_SCALE_LADDER].reverse().find((r) => r < current * 0.999) ?? TIME_SCALE_LADDER[0];
 }

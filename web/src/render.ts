@@ -95,7 +95,7 @@ void main() { frag_colour = vec4(0.75, 0.82, 0.95, 0.35); }`;
 
 // (v + 1) rings of (u + 1) vertices, the seam column repeated; unit vectors are
 // positions and normals at once (viewer/render/sphere_mesh.cpp).
-export function uvSphere(segmentsU: number, segmentsV: number): { vertices: Float32Array; indices: Uint16Array } {
+function uvSphere(segmentsU: number, segmentsV: number): { vertices: Float32Array; indices: Uint16Array } {
   const vertices: number[] = [];
   for (let j = 0; j <= segmentsV; ++j) {
     const theta = (Math.PI * j) / segmentsV;

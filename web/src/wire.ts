@@ -9,7 +9,7 @@ import {
 
 // Set by esbuild from protocol/frame_codec.h's kProtocolVersion (web/CMakeLists.txt).
 declare const FISHTANK_PROTOCOL_VERSION: number;
-export const PROTOCOL_VERSION = FISHTANK_PROTOCOL_VERSION;
+const PROTOCOL_VERSION = FISHTANK_PROTOCOL_VERSION;
 const IDENTIFIER = 'FTNK';
 
 function frame(type: Payload, build: (b: Builder) => number): Uint8Array {
