@@ -53,7 +53,7 @@ struct RowFetch {
   std::uint32_t first_batch = 0, end_batch = 0;
 };
 
-// What a SIMD step asks memory for ahead of use (kernels_simd_ball.h). Results
+// What a SIMD step asks memory for ahead of use (kernels_simd_prefetch.h). Results
 // never depend on it; the scalar twin reads its rows in order and takes none.
 struct PrefetchPlan {
   bool beyond_cache = false;                // ask for rows kPrefetchBatches ahead, and the remote rows

@@ -127,7 +127,7 @@ void accelerations(const StepContext& ctx, Float4* acc, std::uint32_t begin, std
 // Ball i's count entries, as found with their keys d^2 - (r_i + r_j)^2, into
 // list nearest first, ties in the order found. The key is negative exactly
 // while the pair touches and grows with the gap between the surfaces. Every
-// twin's build orders its lists so (kernels_simd_ball.h has the SIMD one),
+// twin's build orders its lists so (kernels_simd_lists.h has the SIMD one),
 // and each ball sums its forces in the same order in all of them; a SIMD step
 // skips the force of a block in which no lane touches, and in this order such
 // blocks are a group's last, holding pairs only the skin keeps. Each entry's
