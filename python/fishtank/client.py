@@ -185,6 +185,27 @@ def _frame(payload_type, build):
     return bytes(b.Output())
 
 
+def _table(b, module, **fields):
+    module.Start(b)
+    for adder, value in fields.items():
+        getattr(module, adder)(b, value)
+    return module.End(b)
+
+
+def _hello_frame(name, player=False, acknowledges=True):
+    """The Hello a client opens with (also the WebSocket tests' and scripts/figures-web-observers')."""
+    def build(b):
+        text = b.CreateString(name)
+        return _table(b, Hello, AddProtocolVersion=PROTOCOL_VERSION, AddClientName=text,
+                      AddWantsPlayer=bool(player), AddAcknowledges=bool(acknowledges))
+
+    return _frame(Payload.Payload.Hello, build)
+
+
+def _ack_frame(tick, want_keyframe=False):
+    return _frame(Payload.Payload.Ack, lambda b: _table(b, Ack, AddTick=tick, AddWantKeyframe=bool(want_keyframe)))
+
+
 class Client:
     """One connection to fishtank-server.
 
@@ -229,7 +250,7 @@ class Client:
         self.welcome = None
         self.ahead_in_line = None  # in line for a sphere: how many clients are before this one (InLine)
         # Not _send: its wait for the reader's reason would wait for a reader not started yet.
-        self._send_frame(_frame(Payload.Payload.Hello, lambda b: self._hello(b, name, player)))
+        self._send_frame(_hello_frame(name, player))
         self._reader = threading.Thread(target=self._read, name=f"fishtank reader {self.address}", daemon=True)
         self._reader.start()
         try:
@@ -300,23 +321,23 @@ class Client:
     def add_balls(self, n):
         """Asks the server to pour n more balls in from the top; raises FishtankError if it took fewer."""
         n = _whole_number(n, "add_balls' n", 1, _UINT32_MAX)
-        self._send(_frame(Payload.Payload.AddBalls, lambda b: self._table(b, AddBalls, AddCount=n)))
+        self._send(_frame(Payload.Payload.AddBalls, lambda b: _table(b, AddBalls, AddCount=n)))
         self._round_trip()
 
     def pause(self):
         """Pauses the simulation for everyone and waits until a snapshot shows it."""
-        return self._control(_frame(Payload.Payload.Pause, lambda b: self._table(b, Pause, AddPaused=True)),
+        return self._control(_frame(Payload.Payload.Pause, lambda b: _table(b, Pause, AddPaused=True)),
                              lambda s: s.paused)
 
     def resume(self):
-        return self._control(_frame(Payload.Payload.Pause, lambda b: self._table(b, Pause, AddPaused=False)),
+        return self._control(_frame(Payload.Payload.Pause, lambda b: _table(b, Pause, AddPaused=False)),
                              lambda s: not s.paused)
 
     def step(self, n=1):
         """Runs n steps while paused and returns the snapshot taken once they are done."""
         n = _whole_number(n, "step's n", 1, _UINT32_MAX)
         before = self._current().physics_steps
-        return self._control(_frame(Payload.Payload.Step, lambda b: self._table(b, Step, AddCount=n)),
+        return self._control(_frame(Payload.Payload.Step, lambda b: _table(b, Step, AddCount=n)),
                              lambda s: (s.physics_steps - before) % 2**32 >= n)
 
     def reset(self, seed=None):
@@ -335,7 +356,7 @@ class Client:
         """Asks for simulated seconds per wall second, 0.1 .. 1, and waits until a snapshot shows it asked for."""
         scale = _time_scale(scale)
         return self._control(_frame(Payload.Payload.SetTimeScale,
-                                    lambda b: self._table(b, SetTimeScale, AddScale=scale)),
+                                    lambda b: _table(b, SetTimeScale, AddScale=scale)),
                              lambda s: s.time_scale_set == scale)
 
     def close(self):
@@ -373,23 +394,6 @@ class Client:
             raise FishtankError("cannot_connect", f"cannot connect to {self.address}: {e.strerror or e}") from None
 
     # ---- sending ----
-
-    @staticmethod
-    def _hello(b, name, player):
-        text = b.CreateString(name)
-        Hello.Start(b)
-        Hello.AddProtocolVersion(b, PROTOCOL_VERSION)
-        Hello.AddClientName(b, text)
-        Hello.AddWantsPlayer(b, bool(player))
-        Hello.AddAcknowledges(b, True)
-        return Hello.End(b)
-
-    @staticmethod
-    def _table(b, module, **fields):
-        module.Start(b)
-        for adder, value in fields.items():
-            getattr(module, adder)(b, value)
-        return module.End(b)
 
     def _restart(self, name, seed):
         seed = None if seed is None else _whole_number(seed, "seed", 0, _UINT64_MAX)
@@ -487,7 +491,7 @@ class Client:
     def _round_trip(self):
         """Waits for a Pong, so that any immediate refusal of what was sent before has arrived."""
         stamp = int(time.monotonic() * 1e6) % 2**32
-        self._send(_frame(Payload.Payload.Ping, lambda b: self._table(b, Ping, AddClientTimeUs=stamp)))
+        self._send(_frame(Payload.Payload.Ping, lambda b: _table(b, Ping, AddClientTimeUs=stamp)))
         deadline = time.monotonic() + self.timeout
         _, before = self._wait(lambda: self._pong if self._pong and self._pong[0] == stamp else None, deadline)
         # A physics-thread answer (AddBalls' tank_full, Step's not_paused, Reset's superseded) is posted to the
@@ -550,8 +554,7 @@ class Client:
     def _acknowledge(self, tick):
         """Ack with want_keyframe: this client holds no base to decode a delta against, so the next comes in full."""
         try:
-            self._send_frame(_frame(Payload.Payload.Ack,
-                                    lambda b: self._table(b, Ack, AddTick=tick, AddWantKeyframe=True)))
+            self._send_frame(_ack_frame(tick, want_keyframe=True))
         except OSError:
             pass  # the server closed the connection: the frames before that say why, and then recv() ends
 

@@ -13,36 +13,19 @@ import subprocess
 import pytest
 import websockets
 
-from fishtank.client import _frame
-from fishtank._protocol import PROTOCOL_VERSION
-from fishtank.wire import Ack, Error, ErrorCode, Hello, Message, Payload, Snapshot
+from fishtank.client import _ack_frame, _hello_frame
+from fishtank.wire import Error, ErrorCode, Message, Payload, Snapshot
 
 TOO_BIG = 1009  # RFC 6455: message too big
 
 
-def _body(payload_type, build):
-    """A frame as the WebSocket carries it: the TCP frame without its 4-byte length prefix."""
-    return _frame(payload_type, build)[4:]
-
-
+# A message as the WebSocket carries it: the TCP frame without its 4-byte length prefix.
 def _hello(name="websocket test"):
-    def build(b):
-        text = b.CreateString(name)
-        Hello.Start(b)
-        Hello.AddProtocolVersion(b, PROTOCOL_VERSION)
-        Hello.AddClientName(b, text)
-        return Hello.End(b)
-
-    return _body(Payload.Payload.Hello, build)
+    return _hello_frame(name, acknowledges=False)[4:]
 
 
 def _ack(tick):
-    def build(b):
-        Ack.Start(b)
-        Ack.AddTick(b, tick)
-        return Ack.End(b)
-
-    return _body(Payload.Payload.Ack, build)
+    return _ack_frame(tick)[4:]
 
 
 def _message(body):
@@ -269,5 +252,5 @@ def test_fishtank_client_at_the_web_port_says_the_servers_reason_and_no_start_a_
     cli = subprocess.run([client, "--connect", f"127.0.0.1:{server.web_port}", "--duration", "1"],
                          capture_output=True, text=True, timeout=30)
     assert cli.returncode == 1
-    assert f"the server closed the connection (wrong_port: " in cli.stderr and f"port {server.port} " in cli.stderr
+    assert "the server closed the connection (wrong_port: " in cli.stderr and f"port {server.port} " in cli.stderr
     assert "To start a server here" not in cli.stderr  # one is there
