@@ -1,8 +1,9 @@
 // The LAMMPS export is complete: every ball with its type, diameter, mass and
 // velocity, every pair coefficient and wall with the damping the server uses;
 // and when LAMMPS is installed, LAMMPS runs the exported scene without losing
-// a ball, and holds a settled pile where Fishtank holds it (both rest on k x
-// under the same weights). The dump writer emits well-formed frames.
+// a ball, rebounds its balls at the server's e (the damping), and holds a
+// settled pile where Fishtank holds it (both rest on k x under the same
+// weights). The dump writer emits well-formed frames.
 
 #include "server/export/lammps_export.h"
 
@@ -68,10 +69,26 @@ TEST_CASE("the exported data file holds every ball exactly", "[export][lammps]")
     CHECK(type == b.kind + 1);
     CHECK(d == Approx(2.0 * b.pos.w));
     CHECK(density * 3.14159265358979 / 6.0 * d * d * d == Approx(b.vel.w));  // LAMMPS mass = the ball's mass
+    CHECK(x == Approx(b.pos.x).margin(1e-5));
     CHECK(y == Approx(b.pos.y).margin(1e-5));
+    CHECK(z == Approx(b.pos.z).margin(1e-5));
   }
   CHECK(rows == 90);
   CHECK(per_type == std::map<int, int>{{1, 30}, {2, 30}, {3, 30}});
+  int moving = 0, velocity_rows = 0;
+  for (auto it = velocities + 2; it != lines.end() && !it->empty(); ++it, ++velocity_rows) {
+    std::istringstream row(*it);
+    int id = 0;
+    double vx = 0, vy = 0, vz = 0;
+    row >> id >> vx >> vy >> vz;
+    const BallView b = world.ball(static_cast<std::uint32_t>(id - 1));
+    CHECK(vx == Approx(b.vel.x).margin(1e-5));
+    CHECK(vy == Approx(b.vel.y).margin(1e-5));
+    CHECK(vz == Approx(b.vel.z).margin(1e-5));
+    moving += std::fabs(vy) > 0.1;
+  }
+  CHECK(velocity_rows == 90);
+  CHECK(moving > 0);  // some are still falling: the velocities are not all zero by chance
 }
 
 TEST_CASE("the exported script has every pair coefficient and wall with the server's damping", "[export][lammps]") {
@@ -81,6 +98,11 @@ TEST_CASE("the exported script has every pair coefficient and wall with the serv
   REQUIRE(export_lammps(world, dir.string(), 100).empty());
   std::map<std::pair<int, int>, double> pair_damping;
   int walls = 0;
+  // Without "damping velocity" LAMMPS scales c by the contact's area (its default, viscoelastic): F = k x - c v_n
+  // holds only with it.
+  const auto damps_on_velocity = [](const std::string& line) {
+    return line.find(" tangential linear_nohistory 0.0 0.0 damping velocity") != std::string::npos;
+  };
   for (const std::string& line : read_lines(dir / "in.fishtank")) {
     std::istringstream in(line);
     std::string word;
@@ -92,8 +114,21 @@ TEST_CASE("the exported script has every pair coefficient and wall with the serv
       in >> a >> b >> model >> k >> c;
       CHECK(model == "hooke");
       CHECK(k == Approx(world.params().stiffness));
+      CHECK(damps_on_velocity(line));
       pair_damping[{a, b}] = c;
     } else if (word == "fix" && line.find("wall/gran") != std::string::npos) {
+      // fix wall_<axis>_<kind> kind<kind> wall/gran granular hooke k c ...: a wall is kinematic, m_eff = m.
+      INFO(line);
+      std::string id, group, style, granular, model;
+      double k = 0, c = 0;
+      in >> id >> group >> style >> granular >> model >> k >> c;
+      const int kind = std::stoi(group.substr(4)) - 1;
+      REQUIRE((kind >= 0 && kind < kKindCount));
+      CHECK(model == "hooke");
+      CHECK(k == Approx(world.params().stiffness));
+      CHECK(c == Approx(2.0 * damping_ratio(0.6f) * std::sqrt(world.params().stiffness * kBallKinds[kind].mass))
+                     .epsilon(1e-6));
+      CHECK(damps_on_velocity(line));
       ++walls;
     } else if (word == "timestep") {
       double dt = 0;
@@ -128,6 +163,55 @@ TEST_CASE("LAMMPS runs the exported scene without losing a ball", "[export][lamm
     if (line.find("Total wall time") != std::string::npos) finished = true;
   }
   CHECK(finished);
+}
+
+TEST_CASE("LAMMPS rebounds the exported balls at the server's e: off the floor and head-on, without gravity",
+          "[export][lammps]") {
+  if (std::system("command -v lmp >/dev/null 2>&1") != 0) {
+    WARN("SKIPPED: lmp is not installed (Debian package lammps: scripts/install-deps lammps)");
+    return;
+  }
+  // A pile at rest does not show the damping; collisions do. One ball of each kind falls onto the floor at 1 m/s,
+  // and a ball of the lightest kind meets one of the heaviest head-on at 2 m/s, each 0.05 from contact.
+  PhysicsParams params;
+  params.gravity = 0.0f;
+  World world(params, kSseKernels, 1, 3);
+  for (int kind = 0; kind < kKindCount; ++kind)
+    world.place_ball(kind, {-10.0f + 10.0f * kind, kBallKinds[kind].diameter / 2 + 0.05f, 0.0f}, {0.0f, -1.0f, 0.0f});
+  const float r_light = kBallKinds[0].diameter / 2, r_heavy = kBallKinds[kKindCount - 1].diameter / 2;
+  world.place_ball(0, {-r_light - 0.025f, 20.0f, 0.0f}, {1.0f, 0.0f, 0.0f});
+  world.place_ball(kKindCount - 1, {r_heavy + 0.025f, 20.0f, 0.0f}, {-1.0f, 0.0f, 0.0f});
+  const auto dir = fresh_dir("fishtank-export-collisions");
+  REQUIRE(export_lammps(world, dir.string(), 200).empty());  // 0.22 s: every contact over (the longest, 34 ms)
+  std::ofstream(dir / "in.fishtank", std::ios::app) << "write_dump all custom final.dump type y vx vy\n";
+  const std::string cmd = "cd '" + dir.string() + "' && lmp -in in.fishtank -log log.lammps > out.txt 2>&1";
+  REQUIRE(std::system(cmd.c_str()) == 0);
+
+  const std::vector<std::string> dump = read_lines(dir / "final.dump");
+  const auto atoms = std::find(dump.begin(), dump.end(), "ITEM: ATOMS type y vx vy");
+  REQUIRE(atoms != dump.end());
+  std::vector<double> floor_rebound(kKindCount, 0.0);
+  double light_vx = 0.0, heavy_vx = 0.0;
+  int read = 0;
+  for (auto line = atoms + 1; line != dump.end(); ++line, ++read) {
+    std::istringstream in(*line);
+    int type = 0;
+    double y = 0, vx = 0, vy = 0;
+    in >> type >> y >> vx >> vy;
+    if (y < 10.0)
+      floor_rebound[type - 1] = vy;  // it came in at 1 m/s
+    else
+      (type == 1 ? light_vx : heavy_vx) = vx;
+  }
+  REQUIRE(read == kKindCount + 2);
+  // LAMMPS's own step (the dashpot on the half-step velocity) misses e by up to 0.04 at this dt, by onset phase
+  // (report 2.5); a missing or area-scaled dashpot rebounds at 0.9 or more, a wall's c taken as a pair's at 0.7.
+  for (int kind = 0; kind < kKindCount; ++kind) {
+    INFO("kind " << kind << " off the floor: " << floor_rebound[kind]);
+    CHECK(floor_rebound[kind] == Approx(0.6).margin(0.05));
+  }
+  INFO("head-on: the light ball leaves at " << light_vx << " m/s, the heavy one at " << heavy_vx);
+  CHECK((heavy_vx - light_vx) / 2.0 == Approx(0.6).margin(0.05));
 }
 
 TEST_CASE("LAMMPS holds a settled pile where Fishtank holds it: the exported k, masses and gravity, ball by ball",
