@@ -4,7 +4,9 @@
 #include "server/net/physics_link.h"
 
 #include <catch2/catch.hpp>
+#include <chrono>
 #include <string>
+#include <thread>
 #include <vector>
 
 using namespace fishtank;
@@ -73,4 +75,30 @@ TEST_CASE("a client's own later reset replaces its earlier one without a refusal
   l.link.at_step_boundary(l.world, LoopStatus{});
   CHECK(l.scene.name() == "wide");
   CHECK(l.replies.empty());
+}
+
+TEST_CASE(
+    "a reset at the next step boundary, before four times the last one's restart has passed, is refused as too "
+    "soon and changes nothing",
+    "[net][sandbox]") {
+  Link l;
+  // A restart of 200 balls takes a fraction of a millisecond: a thread descheduled between the two boundaries
+  // could outlast the spacing, so the pair is tried a few times.
+  bool refused = false;
+  for (int attempt = 0; attempt < 5 && !refused; ++attempt) {
+    if (attempt > 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));  // the last restart's spacing
+    l.replies.clear();
+    l.reset(4, "drop");
+    l.link.at_step_boundary(l.world, LoopStatus{});
+    REQUIRE(l.scene.name() == "drop");
+    const std::uint32_t starts = l.scene.start_count();
+    l.reset(4, "wide");
+    l.link.at_step_boundary(l.world, LoopStatus{});
+    if (l.refusals_of(4) == std::vector<ControlRefusedReply::Why>{ControlRefusedReply::Why::too_soon}) {
+      refused = true;
+      CHECK(l.scene.start_count() == starts);
+      CHECK(l.scene.name() == "drop");
+    }
+  }
+  CHECK(refused);
 }
