@@ -3,6 +3,7 @@
 // finite, and the player stays inside. And the softest k the server accepts
 // (softest_stiffness) still holds a full tank's pile inside, which a third of it does not.
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 
@@ -27,19 +28,28 @@ TEST_CASE("a full tank stays contained while the player ploughs through it", "[p
   const Vec3 directions[] = {{1, 0, 0}, {0, -1, 0}, {-1, 0, 0}, {0, 0, 1}, {0, 1, 0}, {0, 0, -1}, {1, -1, 1}};
   const int steps = static_cast<int>(20.0 / world.dt());
   const int turn_every = static_cast<int>(0.5 / world.dt());
+  float fastest = 0.0f;
   for (int s = 0; s < steps; ++s) {
     if (s % turn_every == 0) world.set_player_velocity(player, directions[(s / turn_every) % 7] * speed);
     world.step();
-    if (s % 500 == 0) REQUIRE(escaped_or_invalid(world) == 0);
+    if (s % 500 != 0) continue;
+    REQUIRE(escaped_or_invalid(world) == 0);
+    fastest = std::max(fastest, max_speed(world));
+    // The whole sphere stays inside, not only its centre.
+    const Vec3 p = world.player_position(player);
+    const float r = 0.5f * kPlayerDiameter, slack = 1e-4f;
+    REQUIRE(p.x - r >= params.tank.min.x - slack);
+    REQUIRE(p.x + r <= params.tank.max.x + slack);
+    REQUIRE(p.y - r >= params.tank.min.y - slack);
+    REQUIRE(p.y + r <= params.tank.max.y + slack);
+    REQUIRE(p.z - r >= params.tank.min.z - slack);
+    REQUIRE(p.z + r <= params.tank.max.z + slack);
   }
   CHECK(escaped_or_invalid(world) == 0);
   CHECK(world.ball_count() == 6000);
-  const Vec3 p = world.player_position(player);
-  CHECK(p.x >= params.tank.min.x);
-  CHECK(p.x <= params.tank.max.x);
-  CHECK(p.y >= params.tank.min.y);
-  CHECK(p.y <= params.tank.max.y);
-  CHECK(std::isfinite(kinetic_energy(world)));
+  // A fall the height of the tank reaches 28 m/s and the sphere adds its 10: a blow-up is far beyond.
+  INFO("fastest ball seen: " << fastest << " m/s");
+  CHECK(fastest < 50.0f);
 }
 
 TEST_CASE("at the softest k the server accepts a full tank's pile holds every ball inside, at a third of it not",

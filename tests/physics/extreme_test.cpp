@@ -12,12 +12,6 @@
 using namespace fishtank;
 using namespace fishtank::test;
 
-namespace {
-
-double total_energy(const World& w) { return kinetic_energy(w) + potential_energy(w) + elastic_energy(w); }
-
-}  // namespace
-
 TEST_CASE("asking for three tanks' worth of balls fills one, refuses the rest, and stays contained",
           "[physics][extreme][slow]") {
   World world(PhysicsParams{}, kSseKernels, 2, 21);

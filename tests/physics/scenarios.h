@@ -22,6 +22,9 @@ inline const Kernels& kernels_named(const std::string& name) {
   return name == "sse" ? kSseKernels : kScalarKernels;
 }
 
+// Kinetic, gravitational and spring energy: what World::energy_added() bounds while damping only removes.
+inline double total_energy(const World& w) { return kinetic_energy(w) + potential_energy(w) + elastic_energy(w); }
+
 // No gravity, in a tank wide enough that nothing reaches a wall by accident.
 inline PhysicsParams open_space() {
   PhysicsParams p;

@@ -44,17 +44,26 @@ TEST_CASE("a tank packed beyond capacity pushes itself apart without losing a ba
   CHECK(kinetic_energy(world) < 0.1 * peak_energy);
 }
 
-TEST_CASE("restitution near 0 and at 1 stays finite and contained", "[physics][stability]") {
+TEST_CASE("restitution near 0 and at 1 stays contained and never holds more energy than the balls brought in",
+          "[physics][stability]") {
   const float e = GENERATE(0.05f, 1.0f);
   PhysicsParams params;
   params.restitution = e;
   World world(params, kSseKernels, 2, 4);
   world.add_balls(800);
-  for (int s = 0; s < static_cast<int>(8.0 / world.dt()); ++s) world.step();
-  INFO("e = " << e);
+  double worst_ratio = 0.0;  // total energy / energy brought in, sampled
+  for (int s = 1; s <= static_cast<int>(8.0 / world.dt()); ++s) {
+    world.step();
+    if (s % 100 == 0 && world.energy_added() > 0.0)
+      worst_ratio = std::max(worst_ratio, total_energy(world) / world.energy_added());
+  }
+  INFO("e = " << e << ": largest total energy / energy brought in " << worst_ratio);
   CHECK(world.ball_count() + world.pending() == 800);
   CHECK(escaped_or_invalid(world) == 0);
-  CHECK(std::isfinite(kinetic_energy(world)));
+  // Velocity Verlet misreads a contact's energy mid-contact by O((w dt)^2) of it (the soak test's bound); a
+  // blow-up, or an e = 1 tank gaining a percent a second, is far above.
+  CHECK(worst_ratio < 1.001);
+  if (e < 0.1f) CHECK(total_energy(world) < 0.9 * world.energy_added());  // damping took its share
 }
 
 TEST_CASE("a pile of low e at the fewest steps per contact settles, and stays settled", "[physics][stability]") {
