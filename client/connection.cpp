@@ -112,6 +112,7 @@ void Connection::handle(const wire::Message& message) {
                                 std::to_string(view_.kinds.size()) + " at most");
       view_.kinds.resize(k.first_new_ball());
       view_.kinds.insert(view_.kinds.end(), k.kinds()->begin(), k.kinds()->end());
+      stats_.kinds_received += k.kinds()->size();
       break;
     }
     case wire::Payload::Snapshot:

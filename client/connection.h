@@ -23,6 +23,7 @@ struct ConnectionStats {
   std::uint64_t snapshots = 0;
   std::uint64_t bytes_received = 0;
   std::uint64_t keyframes = 0;           // snapshots sent in full; the others were deltas
+  std::uint64_t kinds_received = 0;      // ball kinds in every BallKinds message, summed: each ball's once
   std::vector<double> rtt_ms;            // one per Pong
   std::vector<std::string> errors;       // Error messages, "code: message"
   std::vector<std::string> error_codes;  // the code of each Error, e.g. "too_slow"

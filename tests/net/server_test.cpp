@@ -133,7 +133,8 @@ TEST_CASE(
   for (auto& c : all) {
     CHECK(c->stats().errors.empty());
     CHECK(c->view().ball_count > 0);
-    CHECK(c->view().kinds.size() >= c->view().ball_count);  // every ball's kind arrived before the ball
+    CHECK(c->view().kinds.size() >= c->view().ball_count);       // every ball's kind arrived before the ball
+    CHECK(c->stats().kinds_received == c->view().kinds.size());  // and once: a ball's size is not sent again
   }
   CHECK(all[0]->player_id().has_value());
   CHECK_FALSE(all[1]->player_id().has_value());  // observers get no sphere
