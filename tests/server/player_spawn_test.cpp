@@ -3,6 +3,7 @@
 
 #include "server/physics/player_spawn.h"
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <vector>
 
@@ -76,6 +77,10 @@ TEST_CASE("beside a big ball at the centre, players start clear of it and of eac
 TEST_CASE("more players than the points next to the centre still start apart, further out", "[spawn]") {
   const std::vector<Float4> players = join(40, {});
   check_apart_inside_and_near(players, 6.0f);
+  // The first eight take the points next to the centre; the last of 40 cannot, and starts beyond them.
+  float first_ring = 0.0f;
+  for (int a = 0; a < 8; ++a) first_ring = std::max(first_ring, distance(kCentre, players[a]));
+  CHECK(distance(kCentre, players.back()) > first_ring);
 }
 
 TEST_CASE("a world's players start apart, clear of its balls, inside the tank near the centre", "[spawn]") {
