@@ -43,6 +43,19 @@ std::filesystem::path fresh_dir(const std::string& name) {
   return dir;
 }
 
+// Whether lmp is on the PATH; where it is not, the test says it is skipped.
+bool lammps_installed() {
+  if (std::system("command -v lmp >/dev/null 2>&1") == 0) return true;
+  WARN("SKIPPED: lmp is not installed (Debian package lammps: scripts/install-deps lammps)");
+  return false;
+}
+
+// LAMMPS run on the exported in.fishtank in dir, its log in log.lammps: whether it exited 0.
+bool run_lammps(const std::filesystem::path& dir) {
+  const std::string cmd = "cd '" + dir.string() + "' && lmp -in in.fishtank -log log.lammps > out.txt 2>&1";
+  return std::system(cmd.c_str()) == 0;
+}
+
 }  // namespace
 
 TEST_CASE("the exported data file holds every ball exactly", "[export][lammps]") {
@@ -146,16 +159,12 @@ TEST_CASE("the exported script has every pair coefficient and wall with the serv
 }
 
 TEST_CASE("LAMMPS runs the exported scene without losing a ball", "[export][lammps]") {
-  if (std::system("command -v lmp >/dev/null 2>&1") != 0) {
-    WARN("SKIPPED: lmp is not installed (Debian package lammps: scripts/install-deps lammps)");
-    return;
-  }
+  if (!lammps_installed()) return;
   World world(PhysicsParams{}, kSseKernels, 1, 2);
   pour_small_scene(world);
   const auto dir = fresh_dir("fishtank-export-run");
   REQUIRE(export_lammps(world, dir.string(), 2000).empty());
-  const std::string cmd = "cd '" + dir.string() + "' && lmp -in in.fishtank -log log.lammps > out.txt 2>&1";
-  REQUIRE(std::system(cmd.c_str()) == 0);
+  REQUIRE(run_lammps(dir));
   const std::vector<std::string> log = read_lines(dir / "log.lammps");
   bool finished = false;
   for (const std::string& line : log) {
@@ -167,10 +176,7 @@ TEST_CASE("LAMMPS runs the exported scene without losing a ball", "[export][lamm
 
 TEST_CASE("LAMMPS rebounds the exported balls at the server's e: off the floor and head-on, without gravity",
           "[export][lammps]") {
-  if (std::system("command -v lmp >/dev/null 2>&1") != 0) {
-    WARN("SKIPPED: lmp is not installed (Debian package lammps: scripts/install-deps lammps)");
-    return;
-  }
+  if (!lammps_installed()) return;
   // A pile at rest does not show the damping; collisions do. One ball of each kind falls onto the floor at 1 m/s,
   // and a ball of the lightest kind meets one of the heaviest head-on at 2 m/s, each 0.05 from contact.
   PhysicsParams params;
@@ -184,8 +190,7 @@ TEST_CASE("LAMMPS rebounds the exported balls at the server's e: off the floor a
   const auto dir = fresh_dir("fishtank-export-collisions");
   REQUIRE(export_lammps(world, dir.string(), 200).empty());  // 0.22 s: every contact over (the longest, 34 ms)
   std::ofstream(dir / "in.fishtank", std::ios::app) << "write_dump all custom final.dump type y vx vy\n";
-  const std::string cmd = "cd '" + dir.string() + "' && lmp -in in.fishtank -log log.lammps > out.txt 2>&1";
-  REQUIRE(std::system(cmd.c_str()) == 0);
+  REQUIRE(run_lammps(dir));
 
   const std::vector<std::string> dump = read_lines(dir / "final.dump");
   const auto atoms = std::find(dump.begin(), dump.end(), "ITEM: ATOMS type y vx vy");
@@ -216,10 +221,7 @@ TEST_CASE("LAMMPS rebounds the exported balls at the server's e: off the floor a
 
 TEST_CASE("LAMMPS holds a settled pile where Fishtank holds it: the exported k, masses and gravity, ball by ball",
           "[export][lammps]") {
-  if (std::system("command -v lmp >/dev/null 2>&1") != 0) {
-    WARN("SKIPPED: lmp is not installed (Debian package lammps: scripts/install-deps lammps)");
-    return;
-  }
+  if (!lammps_installed()) return;
   // 150 balls in a tank 8 wide: a pile some layers deep, so that ball-ball contacts carry weight too.
   PhysicsParams params;
   params.tank.min = {-4.0f, 0.0f, -4.0f};
@@ -233,8 +235,7 @@ TEST_CASE("LAMMPS holds a settled pile where Fishtank holds it: the exported k, 
   constexpr int kSteps = 2000;
   REQUIRE(export_lammps(world, dir.string(), kSteps).empty());
   std::ofstream(dir / "in.fishtank", std::ios::app) << "write_dump all custom final.dump id x y z modify sort id\n";
-  const std::string cmd = "cd '" + dir.string() + "' && lmp -in in.fishtank -log log.lammps > out.txt 2>&1";
-  REQUIRE(std::system(cmd.c_str()) == 0);
+  REQUIRE(run_lammps(dir));
   for (int s = 0; s < kSteps; ++s) world.step();
 
   const std::vector<std::string> dump = read_lines(dir / "final.dump");
