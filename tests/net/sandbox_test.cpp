@@ -13,64 +13,24 @@
 
 #include "client/connection.h"
 #include "client/script.h"
+#include "clients.h"
 #include "protocol/frame_codec.h"
 #include "server_process.h"
 
 using namespace fishtank;
 using client::Connection;
+using test::Clients;
+using test::errors_with;
 using test::ServerProcess;
 using Clock = std::chrono::steady_clock;
 using std::chrono::milliseconds;
 namespace asio = boost::asio;
 
-namespace {
-
-class Clients {
- public:
-  explicit Clients(std::uint16_t port) : server_(asio::ip::make_address("127.0.0.1"), port) {}
-  ~Clients() {
-    for (auto& c : all_) c->close();
-    run_for(milliseconds(50));
-  }
-
-  // Connected, welcomed and holding a first snapshot.
-  std::shared_ptr<Connection> add(bool wants_player) {
-    auto c = std::make_shared<Connection>(io_, "sandbox-" + std::to_string(all_.size() + 1), wants_player);
-    c->start(server_);
-    all_.push_back(c);
-    REQUIRE(wait_until([&] { return c->stats().snapshots > 0; }));
-    return c;
-  }
-  void run_for(milliseconds d) {
-    io_.restart();
-    io_.run_for(d);
-  }
-  bool wait_until(const std::function<bool()>& done, milliseconds timeout = milliseconds(5000)) {
-    const Clock::time_point deadline = Clock::now() + timeout;
-    while (!done() && Clock::now() < deadline) run_for(milliseconds(10));
-    return done();
-  }
-
- private:
-  asio::io_context io_;
-  asio::ip::tcp::endpoint server_;
-  std::vector<std::shared_ptr<Connection>> all_;
-};
-
-// The errors whose code is `code` ("not_paused: ...").
-int errors_with(const Connection& c, const std::string& code) {
-  int n = 0;
-  for (const std::string& e : c.stats().errors) n += e.rfind(code + ":", 0) == 0;
-  return n;
-}
-
-}  // namespace
-
 TEST_CASE("a paused server keeps sending snapshots without stepping, Step runs exactly that many, resume runs on",
           "[net][sandbox]") {
   ServerProcess server({"--balls", "200"});
   Clients clients(server.port());
-  auto player = clients.add(true);
+  auto player = clients.add_watching(true);
   player->send(protocol::encode_pause(true));
   REQUIRE(clients.wait_until([&] { return player->view().paused; }));
   clients.run_for(milliseconds(100));
@@ -98,8 +58,8 @@ TEST_CASE(
     "[net][sandbox]") {
   ServerProcess server({"--balls", "200"});
   Clients clients(server.port());
-  auto sender = clients.add(true);
-  auto other = clients.add(true);
+  auto sender = clients.add_watching(true);
+  auto other = clients.add_watching(true);
   sender->send(protocol::encode_step(10));
   sender->send(protocol::encode_reset("cube", std::nullopt));
   sender->send(protocol::encode_set_time_scale(5.0f));
@@ -127,8 +87,8 @@ TEST_CASE(
     "[net][sandbox]") {
   ServerProcess server({"--balls", "300"});
   Clients clients(server.port());
-  auto observer = clients.add(false);
-  auto player = clients.add(true);
+  auto observer = clients.add_watching(false);
+  auto player = clients.add_watching(true);
   CHECK_FALSE(observer->may_control());
   CHECK(player->may_control());
   CHECK(observer->control_policy().find("observers may not") != std::string::npos);
@@ -161,7 +121,7 @@ TEST_CASE("a time scale of 0.5 runs simulated time at half the wall clock's pace
           "[net][sandbox]") {
   ServerProcess server({"--balls", "100", "--status-interval", "0.25"});
   Clients clients(server.port());
-  auto player = clients.add(true);
+  auto player = clients.add_watching(true);
   player->send(protocol::encode_set_time_scale(0.5f));
   REQUIRE(clients.wait_until([&] { return player->view().time_scale_set == 0.5f; }));
   clients.run_for(milliseconds(600));  // a status interval or two at the new pace
@@ -177,7 +137,7 @@ TEST_CASE("a time scale of 0.5 runs simulated time at half the wall clock's pace
 TEST_CASE("with --control nobody even a player's pause is refused", "[net][sandbox]") {
   ServerProcess server({"--balls", "50", "--control", "nobody"});
   Clients clients(server.port());
-  auto player = clients.add(true);
+  auto player = clients.add_watching(true);
   CHECK_FALSE(player->may_control());
   player->send(protocol::encode_pause(true));
   REQUIRE(clients.wait_until([&] { return errors_with(*player, "not_permitted") == 1; }));
@@ -223,8 +183,8 @@ TEST_CASE("a burst of resets is coalesced, any refused only as server busy, and 
   // 3000 balls placed at each start; the command-flood limit is raised above the burst, which is not its subject.
   ServerProcess server({"--scene", "dam-break", "--max-commands", "1000"});
   Clients clients(server.port());
-  auto sender = clients.add(true);
-  auto other = clients.add(false);
+  auto sender = clients.add_watching(true);
+  auto other = clients.add_watching(false);
   const std::uint32_t start = sender->view().scene_start;
   for (int i = 0; i < 300; ++i) sender->send(protocol::encode_reset("", i));
   const std::uint64_t seen = other->stats().snapshots;

@@ -6,7 +6,6 @@
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <cmath>
-#include <functional>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -15,90 +14,25 @@
 
 #include "client/connection.h"
 #include "client/script.h"
+#include "clients.h"
 #include "protocol/frame_codec.h"
 #include "server_process.h"
 #include "wire_bytes.h"
 
 using namespace fishtank;
 using client::Connection;
+using test::Clients;
 using test::error_codes;
 using test::first_error_code;
 using test::frame_with_length;
+using test::has_error;
+using test::measure_rates;
 using test::RawSocket;
 using test::ServerProcess;
 using test::wait_until;
 using Clock = std::chrono::steady_clock;
-namespace asio = boost::asio;
 
 namespace {
-
-// Connections sharing one io_context, pumped by the test thread.
-class Clients {
- public:
-  explicit Clients(std::uint16_t port) : server_(asio::ip::make_address("127.0.0.1"), port) {}
-
-  std::shared_ptr<Connection> add(bool wants_player, std::uint32_t version = protocol::kProtocolVersion) {
-    auto c = std::make_shared<Connection>(io_, "test-" + std::to_string(all_.size() + 1), wants_player);
-    c->start(server_, version);
-    all_.push_back(c);
-    return c;
-  }
-  void run_for(std::chrono::milliseconds d) {
-    io_.restart();
-    io_.run_for(d);
-  }
-  // Pumps until done() or the timeout; returns done().
-  bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
-    const Clock::time_point deadline = Clock::now() + timeout;
-    while (!done() && Clock::now() < deadline) run_for(std::chrono::milliseconds(10));
-    return done();
-  }
-  bool all_welcomed() const {
-    return std::all_of(all_.begin(), all_.end(), [](auto& c) { return c->welcomed(); });
-  }
-  ~Clients() {
-    for (auto& c : all_) c->close();
-    run_for(std::chrono::milliseconds(50));
-  }
-
- private:
-  asio::io_context io_;
-  asio::ip::tcp::endpoint server_;
-  std::vector<std::shared_ptr<Connection>> all_;
-};
-
-bool has_error(const Connection& c, const std::string& code) {
-  return std::any_of(c.stats().errors.begin(), c.stats().errors.end(),
-                     [&](const std::string& e) { return e.rfind(code, 0) == 0; });
-}
-
-// Every connection's snapshot count over `seconds` of pumping, as a rate.
-std::vector<double> measure_rates(Clients& clients, const std::vector<std::shared_ptr<Connection>>& of,
-                                  double seconds) {
-  std::vector<std::uint64_t> before;
-  for (auto& c : of) before.push_back(c->stats().snapshots);
-  clients.run_for(std::chrono::milliseconds(static_cast<int>(seconds * 1000)));
-  std::vector<double> rates;
-  for (std::size_t i = 0; i < of.size(); ++i) rates.push_back((of[i]->stats().snapshots - before[i]) / seconds);
-  return rates;
-}
-
-// `pings` Pings a quarter of a second apart from c, then a second for the last Pongs: the round trips, sorted.
-std::vector<double> ping_round_trips(Clients& clients, Connection& c, int pings) {
-  for (int ping = 0; ping < pings; ++ping) {
-    c.send_ping();
-    clients.run_for(std::chrono::milliseconds(250));
-  }
-  clients.run_for(std::chrono::milliseconds(1000));
-  std::vector<double> rtt = c.stats().rtt_ms;
-  std::sort(rtt.begin(), rtt.end());
-  return rtt;
-}
-
-std::string round_trips_text(const std::vector<double>& rtt, int pings) {
-  return std::to_string(rtt.size()) + " of " + std::to_string(pings) + " Pings answered; round trips " +
-         (rtt.empty() ? "none" : std::to_string(rtt.front()) + " .. " + std::to_string(rtt.back())) + " ms";
-}
 
 // The server's status lines ("t = ... s  balls ..."), oldest first.
 std::vector<std::string> status_lines(const ServerProcess& server) {
@@ -317,148 +251,6 @@ TEST_CASE("a protocol version mismatch is refused with a clear Error and a disco
   CHECK_THAT(old_client->stats().errors.front(), Catch::Contains("protocol version"));
 }
 
-TEST_CASE("more clients than --max-players wait in line, told so, and get freed spheres first come first served",
-          "[net]") {
-  ServerProcess server({"--balls", "0", "--max-players", "1"});
-  Clients clients(server.port());
-  auto first = clients.add(true);
-  REQUIRE(clients.wait_until([&] { return first->welcomed(); }, std::chrono::seconds(5)));
-  auto second = clients.add(true);
-  REQUIRE(clients.wait_until([&] { return second->welcomed(); }, std::chrono::seconds(5)));
-  // One at a time: two Hellos sent together may join the line in either order.
-  auto third = clients.add(true);
-  REQUIRE(clients.wait_until([&] { return third->welcomed(); }, std::chrono::seconds(5)));
-  auto quitter = clients.add(true);
-  auto observer = clients.add(false);
-  REQUIRE(clients.wait_until([&] { return clients.all_welcomed(); }, std::chrono::seconds(5)));
-  REQUIRE(first->player_id().has_value());
-  CHECK_FALSE(second->player_id().has_value());
-  REQUIRE(has_error(*second, "player_limit"));
-  CHECK_THAT(second->stats().errors.front(), Catch::Contains("in line for the next one freed"));
-  CHECK(observer->stats().errors.empty());  // it asked for none, so it is not in line
-  CHECK_FALSE(observer->ahead_in_line().has_value());
-  // Each in line knows its place.
-  REQUIRE(clients.wait_until([&] { return quitter->ahead_in_line() == 2u; }, std::chrono::seconds(5)));
-  CHECK(second->ahead_in_line() == 0u);
-  CHECK(third->ahead_in_line() == 1u);
-
-  // One in line that leaves gives up its place: the sphere skips it.
-  quitter->close();
-  clients.run_for(std::chrono::milliseconds(200));
-  first->close();
-  REQUIRE(clients.wait_until([&] { return second->player_id().has_value(); }, std::chrono::seconds(5)));
-  CHECK(second->stats().player_granted);
-  CHECK_FALSE(second->ahead_in_line().has_value());
-  CHECK_FALSE(third->player_id().has_value());
-  REQUIRE(clients.wait_until([&] { return third->ahead_in_line() == 0u; }, std::chrono::seconds(5)));
-  CHECK(second->may_control());  // the default policy: players may control
-
-  // The granted sphere is second's to move.
-  const std::uint32_t id = *second->player_id();
-  REQUIRE(clients.wait_until([&] { return observer->player_position(id).has_value(); }, std::chrono::seconds(5)));
-  const Vec3 start = *observer->player_position(id);
-  second->send(protocol::encode_player_input(1, {5.0f, 0.0f, 0.0f}));
-  clients.run_for(std::chrono::milliseconds(600));
-  second->send(protocol::encode_player_input(2, {0.0f, 0.0f, 0.0f}));
-  REQUIRE(
-      clients.wait_until([&] { return observer->player_position(id)->x > start.x + 1.0f; }, std::chrono::seconds(5)));
-
-  second->close();
-  REQUIRE(clients.wait_until([&] { return third->player_id().has_value(); }, std::chrono::seconds(5)));
-  CHECK_FALSE(observer->player_id().has_value());
-  CHECK(third->stats().errors.size() == 1);  // player_limit, and nothing since
-}
-
-TEST_CASE("through joins and leaves in any order, every sphere has one holder and none waits while one is free",
-          "[net]") {
-  constexpr int kMaxPlayers = 4;
-  // Room for every connection opened in a burst to wait for its Welcome, none evicted as a stranger's.
-  ServerProcess server(
-      {"--balls", "0", "--max-players", std::to_string(kMaxPlayers), "--max-pending-per-address", "64"});
-  Clients clients(server.port());
-  auto watcher = clients.add(false);
-  std::vector<std::shared_ptr<Connection>> live;
-  std::uint32_t seed = 12345;
-  const auto next_random = [&] { return seed = seed * 1664525u + 1013904223u; };
-  for (int round = 0; round < 60; ++round) {
-    // Mostly joins while few are connected, mostly leaves while many are: the line grows and empties.
-    if (live.empty() || next_random() % 12 >= live.size())
-      live.push_back(clients.add(true));
-    else {
-      const auto leaving = live.begin() + next_random() % live.size();
-      (*leaving)->close();
-      live.erase(leaving);
-    }
-    clients.run_for(std::chrono::milliseconds(next_random() % 30));
-  }
-  const auto holders = [&] {
-    std::vector<std::uint32_t> ids;
-    for (auto& c : live)
-      if (c->player_id()) ids.push_back(*c->player_id());
-    std::sort(ids.begin(), ids.end());
-    return ids;
-  };
-  const auto spheres = [&] {
-    std::vector<std::uint32_t> ids = watcher->view().player_ids;
-    std::sort(ids.begin(), ids.end());
-    return ids;
-  };
-  const std::size_t expected = std::min<std::size_t>(live.size(), kMaxPlayers);
-  INFO(live.size() << " clients want a sphere at the end");
-  REQUIRE(clients.wait_until([&] { return holders().size() == expected && spheres() == holders(); },
-                             std::chrono::seconds(10)));
-  const std::vector<std::uint32_t> held = holders();
-  CHECK(std::adjacent_find(held.begin(), held.end()) == held.end());  // no sphere with two holders
-  // Those in line hold the places 0, 1, 2, ... each once.
-  const auto places = [&] {
-    std::vector<std::uint32_t> ahead;
-    for (auto& c : live)
-      if (!c->player_id()) ahead.push_back(c->ahead_in_line().value_or(999));
-    std::sort(ahead.begin(), ahead.end());
-    return ahead;
-  };
-  const auto first_places = [](std::size_t n) {
-    std::vector<std::uint32_t> v(n);
-    for (std::size_t i = 0; i < n; ++i) v[i] = static_cast<std::uint32_t>(i);
-    return v;
-  };
-  CHECK(clients.wait_until([&] { return places() == first_places(live.size() - expected); }, std::chrono::seconds(5)));
-  // Closing every holder hands each sphere on down the line until the line is empty.
-  while (!live.empty()) {
-    auto holder = std::find_if(live.begin(), live.end(), [](auto& c) { return c->player_id().has_value(); });
-    REQUIRE(holder != live.end());
-    (*holder)->close();
-    live.erase(holder);
-    const std::size_t now_expected = std::min<std::size_t>(live.size(), kMaxPlayers);
-    REQUIRE(clients.wait_until([&] { return holders().size() == now_expected && spheres() == holders(); },
-                               std::chrono::seconds(10)));
-    CHECK(clients.wait_until([&] { return places() == first_places(live.size() - now_expected); },
-                             std::chrono::seconds(5)));
-  }
-  CHECK(spheres().empty());
-}
-
-TEST_CASE("a sphere freed as unmoved (player_idle) goes to the one in line, not back to its idler", "[net]") {
-  // 2 s of grace: the second client must be welcomed into the line before the idler's sphere is freed.
-  ServerProcess server({"--balls", "0", "--max-players", "1", "--player-idle", "2"});
-  Clients clients(server.port());
-  auto idler = clients.add(true);
-  REQUIRE(clients.wait_until([&] { return idler->welcomed(); }, std::chrono::seconds(5)));
-  auto waiting = clients.add(true);
-  REQUIRE(clients.wait_until([&] { return waiting->welcomed(); }, std::chrono::seconds(5)));
-  REQUIRE(idler->player_id().has_value());
-  REQUIRE_FALSE(waiting->player_id().has_value());
-
-  REQUIRE(clients.wait_until([&] { return waiting->player_id().has_value(); }, std::chrono::seconds(10)));
-  CHECK(has_error(*idler, "player_idle"));
-  CHECK_FALSE(idler->player_id().has_value());
-  CHECK_FALSE(idler->closed());
-  // The granted sphere has its own idle deadline: unmoved, it is freed in turn, and nobody waits for it.
-  REQUIRE(clients.wait_until([&] { return has_error(*waiting, "player_idle"); }, std::chrono::seconds(10)));
-  CHECK_FALSE(waiting->player_id().has_value());
-  CHECK_FALSE(idler->player_id().has_value());
-}
-
 TEST_CASE("a client that says Watching off gets no snapshots but its replies, and on again gets deltas it decodes",
           "[net]") {
   ServerProcess server({"--balls", "300"});
@@ -559,98 +351,6 @@ TEST_CASE("bad bytes from one client: Error and disconnect for it - the server a
   auto newcomer = clients.add(true);
   CHECK(clients.wait_until([&] { return newcomer->stats().snapshots > 0; }, std::chrono::seconds(5)));
   CHECK(watcher->stats().errors.empty());
-}
-
-TEST_CASE("clients that never read: the server's memory stays bounded and others keep their snapshot rate", "[net]") {
-  // 2000 balls at 400 Hz: 12 kB a snapshot, 4.8 MB/s per client. Once the
-  // kernel's socket buffers are full (a few MB each, within the first second),
-  // four stalled clients with unbounded queues would pile up 19 MB a second.
-  ServerProcess server({"--balls", "2000", "--snapshot-rate", "400"});
-  Clients clients(server.port());
-  auto watcher = clients.add(false);
-  REQUIRE(clients.wait_until([&] { return watcher->view().ball_count > 1500; }, std::chrono::seconds(15)));
-
-  std::vector<std::unique_ptr<RawSocket>> stalled;
-  for (int i = 0; i < 4; ++i) {
-    stalled.push_back(std::make_unique<RawSocket>(server.port(), /*receive_buffer=*/4096));
-    stalled.back()->send(protocol::encode_hello("stalled", false, false));
-  }
-  clients.run_for(std::chrono::milliseconds(1500));  // their socket buffers fill up
-  const long rss_start = server.rss_kb();
-  const double rate = measure_rates(clients, {watcher}, 3.0).front();
-  const long rss_end = server.rss_kb();
-  INFO("server RSS " << rss_start << " kB -> " << rss_end << " kB");
-#if defined(__SANITIZE_ADDRESS__)
-  // AddressSanitizer keeps freed blocks in quarantine (256 MB by default), so
-  // the server's RSS grows with every freed snapshot; the Release run checks it.
-  WARN("AddressSanitizer build: RSS not meaningful (" << rss_end - rss_start << " kB growth)");
-  // The instrumented server encodes and sends a few times slower; the watcher must still be served.
-  CHECK(rate > 100.0);
-#else
-  CHECK(rss_end - rss_start < 8 * 1024);  // unbounded queues would add far more
-  CHECK(rate > 300.0);                    // 400 Hz asked
-#endif
-  CHECK(server.running());
-  CHECK(watcher->stats().errors.empty());
-}
-
-TEST_CASE("a client on a slow link gets fewer snapshots, not older ones: its picture stays under a second behind",
-          "[net]") {
-  // 3000 balls pouring: 60 snapshots a second of 5-18 kB, several times what 100 kB/s carries. Sent all the same,
-  // they would queue in the sockets' buffers and the picture fall further behind every second (8 s after 8 s).
-  ServerProcess server({"--balls", "3000"});
-  Clients clients(server.port());
-  auto slow = clients.add(false);
-  slow->limit_read_rate(100e3);
-  REQUIRE(clients.wait_until([&] { return slow->stats().snapshots > 0; }, std::chrono::seconds(10)));
-  const std::vector<double> rtt = ping_round_trips(clients, *slow, 32);  // 8 s, from its first snapshot on
-  INFO(round_trips_text(rtt, 32));
-  REQUIRE(rtt.size() >= 28);  // a Pong waits behind what the sockets queue
-  CHECK(rtt[rtt.size() / 2] < 500.0);
-  CHECK(rtt.back() < 1500.0);
-  CHECK(slow->stats().snapshots >= 16);  // still a picture or more a second
-  CHECK(slow->stats().errors.empty());
-  CHECK_THAT(server.log(), Catch::Contains("snapshots/s skipped for slow clients"));  // the status line says so
-}
-
-TEST_CASE("a client joining a full tank over a slow link starts without a queue: one keyframe, no lag from the first",
-          "[net]") {
-  // 3000 balls placed at once: a keyframe is 18 kB, 0.3 s of this link. Its Hello says it acknowledges, so the
-  // server sends nothing more until that first Ack; unpaced until then, 18 keyframes would queue (5 s of link).
-  ServerProcess server({"--scene", "dam-break", "--balls", "3000"});
-  Clients clients(server.port());
-  auto slow = clients.add(false);
-  slow->limit_read_rate(60e3);
-  REQUIRE(clients.wait_until([&] { return slow->stats().snapshots > 0; }, std::chrono::seconds(10)));
-  const std::vector<double> rtt = ping_round_trips(clients, *slow, 16);  // 4 s
-  INFO(round_trips_text(rtt, 16) << "; " << slow->stats().keyframes << " keyframes of " << slow->stats().snapshots);
-  REQUIRE(rtt.size() >= 14);
-  CHECK(rtt.back() < 1500.0);
-  CHECK(slow->stats().keyframes <= 2);
-  CHECK(slow->stats().errors.empty());
-}
-
-TEST_CASE("a client that stops answering its snapshots is closed after --idle-timeout and told why", "[net]") {
-  // Its snapshots wait for its Acks, so no write stalls: the watchdog counts from the oldest unanswered one.
-  ServerProcess server({"--balls", "300", "--idle-timeout", "1"});
-  Clients clients(server.port());
-  auto silent = clients.add(false);
-  REQUIRE(clients.wait_until([&] { return silent->stats().snapshots > 10; }, std::chrono::seconds(5)));
-  silent->acknowledge_snapshots(false);  // it still reads everything, and sends nothing more
-  REQUIRE(clients.wait_until([&] { return silent->closed(); }, std::chrono::seconds(8)));
-  CHECK(has_error(*silent, "idle_timeout"));
-  CHECK(server.running());
-}
-
-TEST_CASE("players who join together start apart, not as one sphere", "[net]") {
-  ServerProcess server({"--balls", "0"});
-  Clients clients(server.port());
-  std::vector<std::shared_ptr<Connection>> players;
-  for (int i = 0; i < 3; ++i) players.push_back(clients.add(true));
-  REQUIRE(clients.wait_until([&] { return players[0]->view().player_ids.size() == 3; }, std::chrono::seconds(5)));
-  const std::vector<Vec3>& at = players[0]->view().player_positions;
-  for (std::size_t i = 0; i < at.size(); ++i)
-    for (std::size_t j = 0; j < i; ++j) CHECK(length(at[i] - at[j]) >= kPlayerDiameter);
 }
 
 TEST_CASE("physics far over its real-time budget: observers keep their snapshot rate and are told of slow motion",
