@@ -10,6 +10,8 @@ namespace {
 constexpr float kPi = 3.14159265358979f;
 // Softer, even without gravity, a contact lasts over 2.2 s: steps too far apart to watch.
 constexpr float kSoftestStiffness = 1.0f;
+// The floors the refusals print (six digits, so up to 5e-6 low) are accepted as typed back.
+constexpr float kPrintedSlack = 1e-5f;
 }  // namespace
 
 float damping_ratio(float restitution) {
@@ -33,6 +35,13 @@ float softest_stiffness(const PhysicsParams& p) {
 }
 
 float shortest_dt(float stiffness) { return contact_duration(stiffness) / PhysicsParams::kMaxStepsPerContact; }
+
+std::string dt_too_short_text(float stiffness) {
+  std::ostringstream text;
+  text << "is too short for k = " << stiffness << " N/m: at most " << PhysicsParams::kMaxStepsPerContact
+       << " steps per contact, so dt must be >= " << shortest_dt(stiffness) << " s (or 0 for automatic)";
+  return text.str();
+}
 
 int steps_for_tolerance(float tolerance) {
   return static_cast<int>(std::ceil(std::sqrt(PhysicsParams::kToleranceRule / tolerance) - 1e-4f));
@@ -63,9 +72,8 @@ std::string validate(const PhysicsParams& p) {
         << "], got " << p.tolerance << ": a looser one needs fewer than " << PhysicsParams::kMinStepsPerContact
         << " steps per contact, which is unstable; below " << PhysicsParams::kTightestTolerance
         << " float32 positions cannot resolve a slow contact (use --steps-per-contact for more steps)";
-  else if (p.steps_per_contact != 0 &&
-           (p.steps_per_contact < PhysicsParams::kMinStepsPerContact ||
-            p.steps_per_contact > PhysicsParams::kMaxStepsPerContact))
+  else if (p.steps_per_contact != 0 && (p.steps_per_contact < PhysicsParams::kMinStepsPerContact ||
+                                        p.steps_per_contact > PhysicsParams::kMaxStepsPerContact))
     err << "steps per contact must be in [" << PhysicsParams::kMinStepsPerContact << ", "
         << PhysicsParams::kMaxStepsPerContact << "], got " << p.steps_per_contact;
   else if (!std::isfinite(p.dt) || p.dt < 0.0f)
@@ -76,10 +84,8 @@ std::string validate(const PhysicsParams& p) {
         << PhysicsParams::kMinStepsPerContact
         << " steps, so dt must be <= " << contact_duration(p.stiffness) / PhysicsParams::kMinStepsPerContact
         << " s (automatic: " << contact_duration(p.stiffness) / static_cast<float>(steps_per_contact(p)) << " s)";
-  else if (p.dt > 0.0f && p.dt < shortest_dt(p.stiffness))
-    err << "dt = " << p.dt << " s is too short for k = " << p.stiffness << " N/m: at most "
-        << PhysicsParams::kMaxStepsPerContact << " steps per contact, so dt must be >= " << shortest_dt(p.stiffness)
-        << " s (or 0 for automatic)";
+  else if (p.dt > 0.0f && p.dt < shortest_dt(p.stiffness) * (1.0f - kPrintedSlack))
+    err << "dt = " << p.dt << " s " << dt_too_short_text(p.stiffness);
   else if (!std::isfinite(p.skin) || p.skin < 0.0f || p.skin > 10.0f)
     err << "neighbour skin must be in (0, 10] units, or 0 to follow the motion, got " << p.skin;
   else if (!std::isfinite(p.gravity) || std::fabs(p.gravity) > 1000.0f)
@@ -90,7 +96,7 @@ std::string validate(const PhysicsParams& p) {
     Vec3 s = p.tank.size();
     if (!is_finite(s) || s.x < 4.0f || s.y < 4.0f || s.z < 4.0f || s.x > 1.0e5f || s.z > 1.0e5f || s.y > 1.0e5f)
       err << "tank must be between 4 and 1e5 units on each side";
-    else if (p.stiffness < softest_stiffness(p) * (1.0f - 1e-6f))  // the floor as printed is accepted: float rounding
+    else if (p.stiffness < softest_stiffness(p) * (1.0f - kPrintedSlack))
       err << "stiffness k = " << p.stiffness << " N/m is too soft for gravity " << p.gravity << " m/s^2 in a tank "
           << s.y << " high: a pile that fills it would press balls through each other and the floor; k must be at "
           << "least " << softest_stiffness(p) << " N/m (the default is " << PhysicsParams{}.stiffness << ")";

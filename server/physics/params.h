@@ -28,13 +28,13 @@
 namespace fishtank {
 
 struct PhysicsParams {
-  float stiffness = 2.5e4f;        // k, N/m: keeps a full tank's largest overlap under 10 % of r_min
-  float restitution = 0.6f;        // e, measured rebound / approach normal speed
-  float tolerance = 0.005f;        // largest per-collision restitution error: sets n
-  int steps_per_contact = 0;       // n in dt = t_c / n; 0: from the tolerance
-  float dt = 0.0f;                 // 0: derive from k; otherwise t_c / kMaxStepsPerContact ... t_c / kMinStepsPerContact
-  float skin = 0.0f;               // neighbour-list skin, units; 0: follows the motion (World::adapt_skin)
-  float gravity = 9.81f;           // m/s^2, along -y
+  float stiffness = 2.5e4f;   // k, N/m: keeps a full tank's largest overlap under 10 % of r_min
+  float restitution = 0.6f;   // e, measured rebound / approach normal speed
+  float tolerance = 0.005f;   // largest per-collision restitution error: sets n
+  int steps_per_contact = 0;  // n in dt = t_c / n; 0: from the tolerance
+  float dt = 0.0f;            // 0: derive from k; otherwise t_c / kMaxStepsPerContact ... t_c / kMinStepsPerContact
+  float skin = 0.0f;          // neighbour-list skin, units; 0: follows the motion (World::adapt_skin)
+  float gravity = 9.81f;      // m/s^2, along -y
   float player_max_speed = 10.0f;  // m/s; faster commands are clamped
   TankBounds tank;
 
@@ -68,8 +68,10 @@ float damping_ratio(float restitution);
 float smallest_effective_mass();
 float contact_duration(float stiffness);
 float shortest_dt(float stiffness);  // t_c / kMaxStepsPerContact
+// Why a dt below shortest_dt is refused: "is too short for k = ... (or 0 for automatic)".
+std::string dt_too_short_text(float stiffness);
 int steps_for_tolerance(float tolerance);
-int steps_per_contact(const PhysicsParams& p);  // given, or from the tolerance
+int steps_per_contact(const PhysicsParams& p);   // given, or from the tolerance
 bool dt_from_tolerance(const PhysicsParams& p);  // neither dt nor steps per contact given
 float derived_dt(const PhysicsParams& p);
 inline float starting_skin(const PhysicsParams& p) { return p.skin > 0.0f ? p.skin : PhysicsParams::kStartSkin; }

@@ -194,9 +194,11 @@ TEST_CASE("every bad value is refused with a message naming it and exit code 2",
       {{"--tolerance", "nan"}, "tolerance must be in [0.002, 0.0075]"},
       {{"--dt", "0.01"}, "unstable for k"},
       // Below t_c / 100000, and where a float would read it as 0 (automatic) or a denormal.
-      {{"--dt", "1e-8"}, "--dt 1e-08 is too short for k = 25000 N/m: at most 100000 steps per contact, so at least"},
-      {{"--dt", "1e-40"}, "--dt 1e-40 is too short"},
-      {{"--dt", "1e-46"}, "--dt 1e-46 is too short"},
+      {{"--dt", "1e-8"},
+       "dt = 1e-08 s is too short for k = 25000 N/m: at most 100000 steps per contact, so dt must be"},
+      {{"--dt", "1e-40"}, "s is too short for k = 25000 N/m"},
+      {{"--dt", "1e-46"}, "--dt 1e-46 s is too short for k = 25000 N/m"},
+      {{"--stiffness", "0", "--dt", "0.001"}, "stiffness k must be in"},  // the stiffness first, not a dt floor of inf
       {{"--tolerance", "0.002", "--steps-per-contact", "15"},
        "--tolerance, --steps-per-contact and --dt each set the time step; give one of them, got --tolerance 0.002 "
        "and --steps-per-contact 15"},
@@ -242,11 +244,18 @@ TEST_CASE("every bad value is refused with a message naming it and exit code 2",
   }
 }
 
-TEST_CASE("the range ends the refusals state are accepted: k 784.8 and dt t_c / 100000", "[options]") {
+TEST_CASE("the range ends the refusals state are accepted: k 784.8 and the shortest dt as printed", "[options]") {
   CHECK(parse({"--stiffness", "784.8"}).options);
-  const ParseResult shortest = parse({"--dt", "1.41e-7"});  // t_c / 100000 = 1.405e-7 s at the default k
-  REQUIRE(shortest.options);
-  CHECK(shortest.options->physics.dt == 1.41e-7f);
+  const ParseResult refused = parse({"--dt", "1e-8"});
+  const std::string floor_said = "dt must be >= ";
+  const std::size_t at = refused.message.find(floor_said);
+  REQUIRE(at != std::string::npos);
+  const std::string shortest =
+      refused.message.substr(at + floor_said.size(), refused.message.find(" s", at) - at - floor_said.size());
+  INFO("the refusal's floor: " << shortest);
+  const ParseResult accepted = parse({"--dt", shortest});
+  REQUIRE(accepted.options);
+  CHECK(accepted.options->physics.dt == std::stof(shortest));
   CHECK(parse({"--dt", "0"}).options->physics.dt == 0.0f);  // automatic
 }
 
