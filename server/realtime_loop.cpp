@@ -56,7 +56,7 @@ struct RateWindow {
     const double span = end - start;
     if (span < (first_length > 0.0 ? first_length : length)) return false;
     status.steps_per_s = steps / span;
-    status.load = busy / std::max(wall_end - wall_start, busy);
+    status.load = busy / (wall_end - wall_start);  // its batches all lie within the window
     status.time_scale = steps * dt / (running > 0.0 ? running : span);
     status.pace_kept = asked > 0.0 ? steps * dt / asked : 1.0;
     *this = {end, wall_end, length};
