@@ -18,7 +18,7 @@ inline std::string number_text(double value) {
 // The shortest decimal that reads back as this float, for JSON: a flag's 0.6 prints as 0.6, not as
 // 0.6000000238418579 (the float widened to a double).
 inline double shortest_decimal(float value) {
-  for (int digits = 6; digits < 9; ++digits) {
+  for (int digits = 6; digits <= 9; ++digits) {  // 9 always reads back
     char text[32];
     std::snprintf(text, sizeof text, "%.*g", digits, double(value));
     const double read = std::strtod(text, nullptr);

@@ -77,7 +77,7 @@ nlohmann::json time_steps(TunedStepper& stepper, const BenchSpec& spec, const Se
   j["steps_per_s"] = median_rate / std::max(1u, world.ball_count());
   j["ns_per_ball_step"] = 1e9 / median_rate;
   j["window_ball_steps_per_s"] = rates;
-  j["dt"] = world.dt();
+  j["dt"] = world.params().dt > 0.0f ? shortest_decimal(world.dt()) : world.dt();  // as typed where given
   // Balls this build holds in real time at this dt: ball-steps per second times simulated seconds per step.
   j["realtime_capacity_balls"] = median_rate * world.dt();
   const PhysicsParams& params = world.params();
