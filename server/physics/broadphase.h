@@ -88,7 +88,7 @@ struct BatchReach {
 
 // The rows a batch's lists name far from it in memory: in practice the
 // neighbours across a column block's x faces (sort() above), out of reach of
-// the SIMD step's prefetch ahead (kernels_simd_ball.h, is_remote_row). One row
+// the SIMD step's prefetch ahead (kernels_simd_lists.h, is_remote_row). One row
 // per cache line, up to kMost; past that a row is only fetched late.
 struct RemoteRows {
   static constexpr std::uint32_t kMost = 31;

@@ -209,8 +209,8 @@ TEST_CASE("LAMMPS rebounds the exported balls at the server's e: off the floor a
       (type == 1 ? light_vx : heavy_vx) = vx;
   }
   REQUIRE(read == kKindCount + 2);
-  // LAMMPS's own step (the dashpot on the half-step velocity) misses e by up to 0.04 at this dt, by onset phase
-  // (report 2.5); a missing or area-scaled dashpot rebounds at 0.9 or more, a wall's c taken as a pair's at 0.7.
+  // The margin is LAMMPS's own step's (the dashpot on the half-step velocity), which misses e by onset phase at
+  // this dt (report 2.5); a missing or area-scaled dashpot, or a wall's c taken as a pair's, is well outside it.
   for (int kind = 0; kind < kKindCount; ++kind) {
     INFO("kind " << kind << " off the floor: " << floor_rebound[kind]);
     CHECK(floor_rebound[kind] == Approx(0.6).margin(0.05));

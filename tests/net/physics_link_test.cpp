@@ -82,8 +82,8 @@ TEST_CASE(
     "soon and changes nothing",
     "[net][sandbox]") {
   Link l;
-  // A restart of 200 balls takes a fraction of a millisecond: a thread descheduled between the two boundaries
-  // could outlast the spacing, so the pair is tried a few times.
+  // A restart of 200 balls is quick, so its spacing is short: a thread descheduled between the two boundaries
+  // could outlast it, so the pair is tried a few times.
   bool refused = false;
   for (int attempt = 0; attempt < 5 && !refused; ++attempt) {
     if (attempt > 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));  // the last restart's spacing

@@ -103,7 +103,8 @@ void NetClient::do_connect() {
         asio::async_connect(socket_, results, [this, gen](error_code connect_ec, const tcp::endpoint&) {
           if (gen != generation_) return;
           if (connect_ec) return lose("cannot connect: " + connect_ec.message());
-          socket_.set_option(tcp::no_delay(true), connect_ec);  // small inputs go out at once
+          error_code ignored;
+          socket_.set_option(tcp::no_delay(true), ignored);  // small inputs go out at once
           send(protocol::encode_hello("fishtank-viewer", wants_player_, /*acknowledges=*/true));
           do_read_prefix();
         });
