@@ -170,6 +170,11 @@ def dequantize(q, lo, hi):
     return lo + q.astype(np.float32) * step
 
 
+def _decimal(value):
+    """A float32 the server sent as the shortest decimal that is that float: 0.1 as set, not 0.10000000149011612."""
+    return float(str(np.float32(value)))
+
+
 def _text(raw):
     """A server's words as str: bytes that are not UTF-8 (a foreign server's) as \\xNN instead of an exception."""
     return (raw or b"").decode(errors="backslashreplace")
@@ -261,7 +266,7 @@ class Client:
         w = self.welcome  # player_id and may_control: the reader set them, and keeps them
         self.dt = w.Dt()
         self.steps_per_contact = w.StepsPerContact()  # contact duration of the lightest pair / dt
-        self.tolerance = w.Tolerance()  # the per-collision error dt was chosen for; 0: dt given
+        self.tolerance = _decimal(w.Tolerance())  # the per-collision error dt was chosen for; 0: dt given
         self.control_policy = _text(w.ControlPolicy())
         self.kinds = [(w.BallKinds(k).Diameter(), w.BallKinds(k).Mass()) for k in range(w.BallKindsLength())]
         self._tank = (_vec(w.TankMin()), _vec(w.TankMax()))
@@ -357,7 +362,7 @@ class Client:
         scale = _time_scale(scale)
         return self._control(_frame(Payload.Payload.SetTimeScale,
                                     lambda b: _table(b, SetTimeScale, AddScale=scale)),
-                             lambda s: s.time_scale_set == scale)
+                             lambda s: s.time_scale_set == _decimal(scale))
 
     def close(self):
         self._closing = True
@@ -684,8 +689,8 @@ class Client:
             paused=s.Paused(),
             scene=_text(s.Scene()),
             scene_start=s.SceneStart(),
-            time_scale=s.TimeScale(),
-            time_scale_set=s.TimeScaleSet(),
+            time_scale=_decimal(s.TimeScale()),
+            time_scale_set=_decimal(s.TimeScaleSet()),
             steps_per_s=s.StepsPerS(),
             kinetic_energy_per_ball=s.KineticEnergyPerBall(),
             contacts=s.Contacts(),
