@@ -115,8 +115,8 @@ function frame(nowMs: number): void {
   if (renderer) {  // frames count only where a picture is drawn (none while the context is lost)
     renderer.draw(camera.viewProjection(canvas.width / Math.max(1, canvas.height)), pair, players, own, showTank);
     ++frames;
+    ++framesDrawn;
   }
-  ++framesDrawn;
   const elapsed = nowMs - fpsStarted;
   if (elapsed >= 500) {
     fps = (1000 * frames) / elapsed;
