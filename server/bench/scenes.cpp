@@ -17,6 +17,7 @@ SettleReport settle(TunedStepper& stepper, const SceneSpec& spec) {
   constexpr std::uint64_t kChecksPerReport = 10;
   const auto check_every = static_cast<std::uint64_t>(std::max(1.0, 0.1 / world.dt()));
   SettleReport report;
+  RestWatch rest;
   for (;;) {
     stepper.step();
     const std::uint64_t done = world.steps() - first_step;
@@ -26,7 +27,7 @@ SettleReport settle(TunedStepper& stepper, const SceneSpec& spec) {
     if (done / check_every % kChecksPerReport == 0)
       std::fprintf(stderr, "settling: %.1f s simulated, %u balls in, %u queued, kinetic energy %.2g J/ball\n", sim,
                    world.ball_count(), world.pending(), energy);
-    report.settled = world.pending() == 0 && energy < kRestEnergy;
+    report.settled = rest.settled(world.pending() == 0 && energy < kRestEnergy);
     if (report.settled || sim >= limit) {
       report.sim_seconds = sim;
       report.steps = done;
