@@ -131,6 +131,245 @@ void print_summary(const FrameStats& stats, const ConnectionStatus& s, std::uint
   std::fprintf(stderr, "\n");
 }
 
+// Opens the 1280x1024 OpenGL 3.3 core window (full screen with --fullscreen, later) and loads GL's entry
+// points; nullptr, having said why, where it cannot.
+GLFWwindow* open_window(const ViewerOptions& opt) {
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);  // SPEC 5.2: 1280x1024 or full screen
+  const std::string title = "Fishtank - " + host_port_text(opt.host, opt.port);
+  GLFWwindow* window = glfwCreateWindow(kWindowWidth, kWindowHeight, title.c_str(), nullptr, nullptr);
+  if (!window) {
+    std::fprintf(stderr, "fishtank-viewer: cannot create a 1280x1024 OpenGL 3.3 core window\n");
+    return nullptr;
+  }
+  glfwMakeContextCurrent(window);
+  glfwSwapInterval(1);
+  glewExperimental = GL_TRUE;  // core profiles need it for GLEW 2.x to load every entry point
+  if (GLenum err = glewInit(); err != GLEW_OK) {
+    std::fprintf(stderr, "fishtank-viewer: GLEW: %s\n",
+                 reinterpret_cast<const char*>(glewGetErrorString(err)));
+    glfwDestroyWindow(window);
+    return nullptr;
+  }
+  return window;
+}
+
+// The swap interval does nothing under Xvfb, so a cap of our own keeps a CPU
+// renderer from drawing flat out on the cores it shares with the server.
+FramePacer announced_pacer(const ViewerOptions& opt) {
+  const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  FramePacer pacer(choose_max_fps(opt.max_fps, renderer));
+  const std::string cap =
+      pacer.max_fps() > 0 ? "frames capped at " + std::to_string(pacer.max_fps()) + "/s" : "frames uncapped";
+  std::fprintf(stderr, "fishtank-viewer: %s (%s): %s; --max-fps changes it\n",
+               is_software_renderer(renderer) ? "software OpenGL" : "OpenGL", renderer ? renderer : "unknown",
+               cap.c_str());
+  return pacer;
+}
+
+// One window's frames, in the order app.h draws them. Its GL objects are made
+// and destroyed while the window's context exists.
+class Viewer {
+ public:
+  Viewer(GLFWwindow* window, const ViewerOptions& opt)
+      : opt_(opt),
+        window_(window),
+        pacer_(announced_pacer(opt)),
+        fullscreen_(window),
+        input_(window),
+        hud_(window),
+        net_(opt.host, opt.port, !opt.observer, snapshots_) {
+    if (opt.fullscreen) fullscreen_.toggle();
+    camera_.frame(TankBounds{});
+    hud_view_.observer = opt.observer;
+    hud_view_.show_stats = hud_view_.show_plots = opt.hud;
+    hud_view_.plots = &plots_;
+    glEnable(GL_DEPTH_TEST);
+    glEnable(GL_CULL_FACE);
+    glClearColor(0.055f, 0.066f, 0.09f, 1.0f);
+  }
+
+  // Frames until the window closes; the process exit code.
+  int run() {
+    while (!glfwWindowShouldClose(window_)) frame();
+    const std::shared_ptr<const Snapshot> last = snapshots_.newest();
+    print_summary(stats_, net_.status(), last ? last->ball_count : 0u);
+    // Closed first (--duration, the window): a script waiting for the file must not read success.
+    if (!opt_.screenshot.empty() && !screenshot_tried_) {
+      std::fprintf(stderr, "fishtank-viewer: --screenshot %s not saved: the viewer closed before %s\n",
+                   opt_.screenshot.c_str(),
+                   stats_.total_frames() > 0 ? "its --frames were drawn" : "the first snapshot came");
+      exit_code_ = 1;
+    }
+    return exit_code_;
+  }
+
+ private:
+  void frame() {
+    glfwPollEvents();
+    const double now = steady_seconds();
+    const double cpu_start = thread_cpu_seconds();
+    const std::shared_ptr<const Snapshot> newest = snapshots_.newest();
+    const Actions actions = take_input(now, newest.get());
+    if (minimised(now)) {
+      glfwWaitEventsTimeout(0.25);
+      return;
+    }
+
+    // The pair first, then the status: a snapshot of a new connection is
+    // only ever pushed after that connection's status (and ball kinds).
+    RenderPair pair;
+    const bool have_frame = snapshots_.frame_at(now, pair);
+    const ConnectionStatus status = net_.status();
+    const std::string advice = connection_advice(opt_.host, opt_.port, status.last_error);
+    report_connection(status, advice, reported_error_);
+    instances_.clear();
+    const int own = have_frame && status.info ? place_balls(pair, *status.info) : -1;
+    build_hud(now, status, advice, newest.get());
+    const double cpu_seconds = thread_cpu_seconds() - cpu_start;
+
+    int width = 0, height = 0;
+    glfwGetFramebufferSize(window_, &width, &height);
+    draw(width, height, own);
+    if (actions.screenshot) save_typed_screenshot(now, width, height);
+    if (!opt_.screenshot.empty()) screenshot_option(now, have_frame, status, width, height);
+    glfwSwapBuffers(window_);
+    stats_.frame_done(steady_seconds(), cpu_seconds, have_frame);
+    if (const double sleep = pacer_.sleep_seconds(steady_seconds()); sleep > 0.0)
+      std::this_thread::sleep_for(std::chrono::duration<double>(sleep));
+  }
+
+  // Keys, the mouse and the player's stick; the sandbox's commands go to the server.
+  Actions take_input(double now, const Snapshot* newest) {
+    const Actions a = input_.take_actions();
+    if (a.quit || (opt_.duration > 0.0 && now - started_ >= opt_.duration))
+      glfwSetWindowShouldClose(window_, GLFW_TRUE);
+    if (a.toggle_tank) show_tank_ = !show_tank_;
+    if (a.toggle_help) hud_view_.show_help = !hud_view_.show_help;
+    if (a.toggle_hud) hud_view_.show_stats = !hud_view_.show_stats;
+    if (a.toggle_fullscreen) fullscreen_.toggle();
+    if (a.toggle_plots) hud_view_.show_plots = !hud_view_.show_plots;
+    if (a.add_balls) net_.add_balls(kBallsPerPress);
+    for (protocol::Frame& frame : sandbox_frames(a.sandbox, newest)) net_.send_command(std::move(frame));
+    if (newest) plots_.add(*newest);
+    input_.drive_camera(camera_);
+    if (!opt_.observer) net_.set_velocity(input_.movement(camera_) * kPlayerSpeed);
+    return a;
+  }
+
+  // A minimised window draws nothing: it asks for no snapshots and waits for events instead.
+  bool minimised(double now) {
+    const bool minimised = glfwGetWindowAttrib(window_, GLFW_ICONIFIED) != 0;
+    if (minimised != was_minimised_) {
+      net_.set_watching(!minimised);
+      if (minimised)
+        minimised_at_ = now;
+      else
+        stats_.not_drawn(minimised_at_, now);
+    }
+    was_minimised_ = minimised;
+    return minimised;
+  }
+
+  // This frame's spheres, between the pair's snapshots; the index of our own, or -1.
+  int place_balls(const RenderPair& pair, const ServerInfo& info) {
+    const TankBounds& tank = pair.to->tank;
+    if (!same_box(framed_, tank)) {
+      camera_.frame(tank);
+      tank_outline_.set_bounds(tank);
+      framed_ = tank;
+    }
+    return interpolate(pair, info, instances_);
+  }
+
+  void build_hud(double now, const ConnectionStatus& status, const std::string& advice,
+                 const Snapshot* newest) {
+    hud_view_.fps = stats_.fps();
+    hud_view_.frame_ms = stats_.frame_ms();
+    hud_view_.cpu_ms = stats_.cpu_ms();
+    hud_view_.net = &status;
+    hud_view_.connection_advice = advice;
+    hud_view_.snapshot = newest;
+    hud_view_.render_delay_ms = static_cast<float>(1e3 * snapshots_.render_delay());
+    hud_view_.now = now;
+    hud_.build(hud_view_);
+  }
+
+  void draw(int width, int height, int own) {
+    glViewport(0, 0, width, height);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    const Mat4 view_proj = camera_.view_projection(height > 0 ? static_cast<float>(width) / height : 1.0f);
+    spheres_.draw(view_proj, instances_);
+    if (own >= 0) draw_own_ring(view_proj, instances_[static_cast<std::size_t>(own)], height);
+    if (show_tank_) tank_outline_.draw(view_proj);
+    hud_.render();
+  }
+
+  // Our own sphere in an amber ring, seen through the balls in front of it.
+  void draw_own_ring(const Mat4& view_proj, SphereInstance mine, int height) {
+    mine.rgba = kOutlineRgba;
+    float scale = 1.0f;  // the desktop's scale factor (HiDPI): 8 pixels at 100 %, 12 at 150 %
+    glfwGetWindowContentScale(window_, nullptr, &scale);
+    const float grow =
+        outline_grow(radius_on_screen(view_proj, {mine.x, mine.y, mine.z}, mine.radius, float(height)),
+                     kOutlineMinPixels * scale, kOutlineGrow);
+    spheres_.draw_outline(view_proj, mine, grow);
+    spheres_.draw_hidden(view_proj, mine, grow, kHiddenAlpha);
+  }
+
+  // F12: a new file each time, and a notice on screen and in the terminal.
+  void save_typed_screenshot(double now, int width, int height) {
+    const std::string path = new_screenshot_path();
+    hud_view_.viewer_notice = save_screenshot(path, width, height) ? "screenshot saved: " + path
+                                                                   : "could not save a screenshot at " + path;
+    hud_view_.viewer_notice_time = now;
+    std::fprintf(stderr, "fishtank-viewer: %s\n", hud_view_.viewer_notice.c_str());
+  }
+
+  // --screenshot: saved after --frames frames with the scene, then the viewer closes; or it gives up.
+  void screenshot_option(double now, bool have_frame, const ConnectionStatus& status, int width, int height) {
+    if (have_frame && ++frames_since_snapshot_ >= opt_.frames) {
+      if (!save_screenshot(opt_.screenshot, width, height)) exit_code_ = 1;
+    } else if (!have_frame && now - started_ > opt_.screenshot_timeout) {
+      std::fprintf(stderr, "fishtank-viewer: no snapshot from %s within %.0f s: %s\n",
+                   status.endpoint.c_str(), opt_.screenshot_timeout, status.last_error.c_str());
+      exit_code_ = 1;
+    } else {
+      return;
+    }
+    screenshot_tried_ = true;  // saved, failed or timed out: each says so
+    glfwSetWindowShouldClose(window_, GLFW_TRUE);
+  }
+
+  const ViewerOptions& opt_;
+  GLFWwindow* window_;
+  FramePacer pacer_;
+  FullscreenToggle fullscreen_;
+  Input input_;  // before the HUD, whose ImGui chains to its callbacks
+  Hud hud_;
+  SphereRenderer spheres_;
+  TankOutline tank_outline_;
+  SnapshotBuffer snapshots_;
+  NetClient net_;  // after the buffer it fills, and so stopped before it goes
+  OrbitCamera camera_;
+  FrameStats stats_;
+  LivePlots plots_;
+  HudView hud_view_;  // the toggles and the notice last from frame to frame
+  bool show_tank_ = opt_.tank_outline;
+  std::vector<SphereInstance> instances_;
+  TankBounds framed_;  // the camera frames the tank again only if a server's tank differs
+  int frames_since_snapshot_ = 0;
+  std::string reported_error_;
+  const double started_ = steady_seconds();
+  bool was_minimised_ = false;
+  double minimised_at_ = 0.0;
+  int exit_code_ = 0;
+  bool screenshot_tried_ = false;
+};
+
 }  // namespace
 
 int run_viewer(const ViewerOptions& opt) {
@@ -144,196 +383,12 @@ int run_viewer(const ViewerOptions& opt) {
         "or open the server's browser viewer (the 'web viewer on' line of its log)\n");
     return 1;
   }
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
-  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
-  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-  glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);  // SPEC 5.2: 1280x1024 or full screen
-  const std::string title = "Fishtank - " + host_port_text(opt.host, opt.port);
-  GLFWwindow* window = glfwCreateWindow(kWindowWidth, kWindowHeight, title.c_str(), nullptr, nullptr);
-  if (!window) {
-    std::fprintf(stderr, "fishtank-viewer: cannot create a 1280x1024 OpenGL 3.3 core window\n");
-    return 1;
-  }
-  glfwMakeContextCurrent(window);
-  glfwSwapInterval(1);
-  glewExperimental = GL_TRUE;  // core profiles need it for GLEW 2.x to load every entry point
-  if (GLenum err = glewInit(); err != GLEW_OK) {
-    std::fprintf(stderr, "fishtank-viewer: GLEW: %s\n",
-                 reinterpret_cast<const char*>(glewGetErrorString(err)));
-    return 1;
-  }
-  // The swap interval does nothing under Xvfb, so a cap of our own keeps a CPU
-  // renderer from drawing flat out on the cores it shares with the server.
-  const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-  FramePacer pacer(choose_max_fps(opt.max_fps, renderer));
-  const std::string cap =
-      pacer.max_fps() > 0 ? "frames capped at " + std::to_string(pacer.max_fps()) + "/s" : "frames uncapped";
-  std::fprintf(stderr, "fishtank-viewer: %s (%s): %s; --max-fps changes it\n",
-               is_software_renderer(renderer) ? "software OpenGL" : "OpenGL", renderer ? renderer : "unknown",
-               cap.c_str());
-  FullscreenToggle fullscreen(window);
-  if (opt.fullscreen) fullscreen.toggle();
-
+  GLFWwindow* window = open_window(opt);
+  if (!window) return 1;
   int exit_code = 0;
-  bool screenshot_tried = false;  // --screenshot saved, failed or timed out: each says so
   {
-    // Scope: every GL object is destroyed while the context still exists.
-    Input input(window);
-    Hud hud(window);
-    SphereRenderer spheres;
-    TankOutline tank_outline;
-    SnapshotBuffer snapshots;
-    NetClient net(opt.host, opt.port, !opt.observer, snapshots);
-    OrbitCamera camera;
-    camera.frame(TankBounds{});
-    FrameStats stats;
-    LivePlots plots;
-    std::string viewer_notice;
-    double viewer_notice_time = -1.0;
-
-    glEnable(GL_DEPTH_TEST);
-    glEnable(GL_CULL_FACE);
-    glClearColor(0.055f, 0.066f, 0.09f, 1.0f);
-
-    bool show_tank = opt.tank_outline, show_help = false, show_stats = opt.hud, show_plots = opt.hud;
-    std::vector<SphereInstance> instances;
-    TankBounds framed;  // the camera frames the tank again only if a server's tank differs
-    int frames_since_snapshot = 0;
-    std::string reported_error;
-    const double started = steady_seconds();
-    bool was_minimised = false;
-    double minimised_at = 0.0;
-
-    while (!glfwWindowShouldClose(window)) {
-      glfwPollEvents();
-      const double frame_start = steady_seconds();
-      const double cpu_start = thread_cpu_seconds();
-
-      Actions a = input.take_actions();
-      if (a.quit || (opt.duration > 0.0 && frame_start - started >= opt.duration))
-        glfwSetWindowShouldClose(window, GLFW_TRUE);
-      if (a.toggle_tank) show_tank = !show_tank;
-      if (a.toggle_help) show_help = !show_help;
-      if (a.toggle_hud) show_stats = !show_stats;
-      if (a.toggle_fullscreen) fullscreen.toggle();
-      if (a.toggle_plots) show_plots = !show_plots;
-      if (a.add_balls) net.add_balls(kBallsPerPress);
-      const std::shared_ptr<const Snapshot> newest = snapshots.newest();
-      for (protocol::Frame& frame : sandbox_frames(a.sandbox, newest.get()))
-        net.send_command(std::move(frame));
-      if (newest) plots.add(*newest);
-
-      input.drive_camera(camera);
-      if (!opt.observer) net.set_velocity(input.movement(camera) * kPlayerSpeed);
-      // A minimised window draws nothing: it asks for no snapshots and waits for events instead.
-      const bool minimised = glfwGetWindowAttrib(window, GLFW_ICONIFIED) != 0;
-      if (minimised != was_minimised) {
-        net.set_watching(!minimised);
-        if (minimised)
-          minimised_at = frame_start;
-        else
-          stats.not_drawn(minimised_at, frame_start);
-      }
-      was_minimised = minimised;
-      if (minimised) {
-        glfwWaitEventsTimeout(0.25);
-        continue;
-      }
-
-      // The pair first, then the status: a snapshot of a new connection is
-      // only ever pushed after that connection's status (and ball kinds).
-      RenderPair pair;
-      const bool have_frame = snapshots.frame_at(frame_start, pair);
-      const ConnectionStatus status = net.status();
-      const std::string advice = connection_advice(opt.host, opt.port, status.last_error);
-      report_connection(status, advice, reported_error);
-      int own = -1;
-      instances.clear();
-      if (have_frame && status.info) {
-        const TankBounds& tank = pair.to->tank;
-        if (!same_box(framed, tank)) {
-          camera.frame(tank);
-          tank_outline.set_bounds(tank);
-          framed = tank;
-        }
-        own = interpolate(pair, *status.info, instances);
-      }
-
-      HudView view;
-      view.fps = stats.fps();
-      view.frame_ms = stats.frame_ms();
-      view.cpu_ms = stats.cpu_ms();
-      view.net = &status;
-      view.connection_advice = advice;
-      view.snapshot = newest.get();
-      view.render_delay_ms = static_cast<float>(1e3 * snapshots.render_delay());
-      view.observer = opt.observer;
-      view.show_stats = show_stats;
-      view.show_help = show_help;
-      view.show_plots = show_plots;
-      view.plots = &plots;
-      view.viewer_notice = viewer_notice;
-      view.viewer_notice_time = viewer_notice_time;
-      view.now = frame_start;
-      hud.build(view);
-      const double cpu_seconds = thread_cpu_seconds() - cpu_start;
-
-      int width = 0, height = 0;
-      glfwGetFramebufferSize(window, &width, &height);
-      glViewport(0, 0, width, height);
-      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-      const Mat4 view_proj = camera.view_projection(height > 0 ? static_cast<float>(width) / height : 1.0f);
-      spheres.draw(view_proj, instances);
-      if (own >= 0) {
-        SphereInstance mine = instances[static_cast<std::size_t>(own)];
-        mine.rgba = kOutlineRgba;
-        float scale = 1.0f;  // the desktop's scale factor (HiDPI): 8 pixels at 100 %, 12 at 150 %
-        glfwGetWindowContentScale(window, nullptr, &scale);
-        const float grow =
-            outline_grow(radius_on_screen(view_proj, {mine.x, mine.y, mine.z}, mine.radius, float(height)),
-                         kOutlineMinPixels * scale, kOutlineGrow);
-        spheres.draw_outline(view_proj, mine, grow);
-        spheres.draw_hidden(view_proj, mine, grow, kHiddenAlpha);
-      }
-      if (show_tank) tank_outline.draw(view_proj);
-      hud.render();
-      if (a.screenshot) {
-        const std::string path = new_screenshot_path();
-        viewer_notice = save_screenshot(path, width, height) ? "screenshot saved: " + path
-                                                             : "could not save a screenshot at " + path;
-        viewer_notice_time = frame_start;
-        std::fprintf(stderr, "fishtank-viewer: %s\n", viewer_notice.c_str());
-      }
-
-      if (!opt.screenshot.empty()) {
-        if (have_frame && ++frames_since_snapshot >= opt.frames) {
-          if (!save_screenshot(opt.screenshot, width, height)) exit_code = 1;
-          screenshot_tried = true;
-          glfwSetWindowShouldClose(window, GLFW_TRUE);
-        } else if (!have_frame && frame_start - started > opt.screenshot_timeout) {
-          std::fprintf(stderr, "fishtank-viewer: no snapshot from %s within %.0f s: %s\n",
-                       status.endpoint.c_str(), opt.screenshot_timeout, status.last_error.c_str());
-          exit_code = 1;
-          screenshot_tried = true;
-          glfwSetWindowShouldClose(window, GLFW_TRUE);
-        }
-      }
-      glfwSwapBuffers(window);
-      stats.frame_done(steady_seconds(), cpu_seconds, have_frame);
-      if (const double sleep = pacer.sleep_seconds(steady_seconds()); sleep > 0.0)
-        std::this_thread::sleep_for(std::chrono::duration<double>(sleep));
-    }
-
-    const std::shared_ptr<const Snapshot> last = snapshots.newest();
-    print_summary(stats, net.status(), last ? last->ball_count : 0u);
-    // Closed first (--duration, the window): a script waiting for the file must not read success.
-    if (!opt.screenshot.empty() && !screenshot_tried) {
-      std::fprintf(stderr, "fishtank-viewer: --screenshot %s not saved: the viewer closed before %s\n",
-                   opt.screenshot.c_str(),
-                   stats.total_frames() > 0 ? "its --frames were drawn" : "the first snapshot came");
-      exit_code = 1;
-    }
+    Viewer viewer(window, opt);  // destroyed, with its GL objects, while the context exists
+    exit_code = viewer.run();
   }
   glfwDestroyWindow(window);
   return exit_code;
