@@ -1,8 +1,7 @@
 """A blocking client for fishtank-server's protocol (protocol/fishtank.fbs).
 
-Frames are FlatBuffers size-prefixed buffers: a 4-byte little-endian length,
-then a Message table with file identifier "FTNK" (protocol/frame_codec.h).
-The controls wait until a snapshot shows their effect, so a script reads
+Frames are built and read in fishtank._frames, a script's arguments checked in
+fishtank._arguments. The controls wait until a snapshot shows their effect, so a script reads
 like the experiment it runs; a refusal from the server raises FishtankError.
 
 A thread of the client's own reads the connection and answers each snapshot
@@ -11,33 +10,24 @@ server paces it by what its link carries, as it does a viewer, and a program
 may take as long as it likes between calls: snapshot() returns the newest.
 """
 
-import numbers
 import re
 import socket
 import struct
 import threading
 import time
-from collections.abc import Sequence
 from dataclasses import dataclass
 
-import flatbuffers
 import numpy as np
 
-from fishtank._protocol import PROTOCOL_VERSION
-from fishtank.wire import (Ack, AddBalls, BallKinds, Error, ErrorCode, Hello, InLine, Message, Pause, Payload, Ping,
+from fishtank._arguments import (_UINT32_MAX, _UINT64_MAX, _client_name, _seconds, _time_scale, _velocity,
+                                 _whole_number)
+from fishtank._frames import (_IDENTIFIER, _MAX_FRAME_BYTES, _ack_frame, _decimal, _frame, _hello_frame, _table,
+                              _text, _vec, dequantize)
+from fishtank.wire import (AddBalls, BallKinds, Error, ErrorCode, InLine, Message, Pause, Payload, Ping,
                            PlayerGranted, PlayerInput, Pong, Reset, SetTimeScale, Snapshot as WireSnapshot, Step,
                            Vec3f, Welcome)
 
-_IDENTIFIER = b"FTNK"
-_MAX_FRAME_BYTES = 64 << 20  # the server's cap (kMaxServerFrameBytes)
-_QUANT_STEPS = np.float32(65535.0)  # protocol/quantize.h: kQuantSteps
 _ERROR_NAMES = {value: name for name, value in vars(ErrorCode.ErrorCode).items() if not name.startswith("_")}
-_UINT32_MAX = 2**32 - 1  # AddBalls.count, Step.count
-_UINT64_MAX = 2**64 - 1  # Reset.seed
-_MAX_NAME_BYTES = 64  # protocol/frame_codec.h: kMaxClientNameBytes; the server refuses a longer Hello
-_MIN_TIME_SCALE = np.float32(0.1)  # protocol/frame_codec.h: kMinTimeScale .. kMaxTimeScale
-_MAX_TIME_SCALE = np.float32(1.0)
-_MAX_SECONDS = threading.TIMEOUT_MAX  # the longest wait Python's locks and sockets take
 _SCENES = "tank, wide, dam-break or drop"
 # "host:port" or "[v6]:port" in one string; an unbracketed IPv6 literal ("::1") has more than one colon.
 _HOST_WITH_PORT = re.compile(r"\[([^\]]+)\]:(\d+)|([^:\[\]]+):(\d+)")
@@ -81,72 +71,6 @@ class Snapshot:
     tank_max: np.ndarray
 
 
-def _whole_number(value, what, lowest, highest):
-    """value as an int, or ValueError naming what and its range: the wire's unsigned fields would refuse it
-    less clearly (FlatBuffers' TypeError), and a fraction would be cut silently."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not lowest <= value <= highest:
-        raise ValueError(f"{what} must be a whole number from {lowest} to {highest}, got {value!r}")
-    return int(value)
-
-
-def _seconds(value, what):
-    """value as float seconds, or ValueError naming what: True would pass for one second, and a wait beyond
-    _MAX_SECONDS (infinity too) fails in the lock's or socket's words (OverflowError)."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0 < value <= _MAX_SECONDS:
-        raise ValueError(f"{what} must be a positive number of seconds, at most {_MAX_SECONDS:.0f}, got {value!r}")
-    return float(value)
-
-
-def _float32s(values):
-    """values as floats, or None where one of them does not fit a float32 (the wire's floats)."""
-    try:
-        floats = [float(v) for v in values]
-    except OverflowError:  # an int beyond any float
-        return None
-    with np.errstate(over="ignore"):
-        return floats if np.all(np.isfinite(np.array(floats, dtype=np.float32))) else None
-
-
-def _velocity(velocity):
-    """velocity as three floats, or ValueError: a string or a mapping would pass as its characters or keys, and
-    FlatBuffers would refuse a value beyond float32 as OverflowError."""
-    three = velocity.shape == (3,) if isinstance(velocity, np.ndarray) else (
-        isinstance(velocity, Sequence) and not isinstance(velocity, (str, bytes, bytearray)) and len(velocity) == 3)
-    if not three or not all(isinstance(c, numbers.Real) and not isinstance(c, bool) for c in velocity):
-        raise ValueError("velocity must be three numbers (x, y, z) in m/s, as a tuple, list or numpy array, got "
-                         f"{velocity!r}")
-    floats = _float32s(velocity)
-    if floats is None:
-        raise ValueError(f"velocity must be finite, within a float32's range (3.4e38), got {velocity!r}")
-    return floats
-
-
-def _time_scale(scale):
-    """scale as the float32 the server receives, checked as the server checks it (frame_codec.cpp): a value
-    that rounds into the range is taken, 1.0000001 (a float32 above 1) is not."""
-    if not isinstance(scale, bool) and isinstance(scale, numbers.Real) and (floats := _float32s([scale])):
-        wire = np.float32(floats[0])
-        if _MIN_TIME_SCALE <= wire <= _MAX_TIME_SCALE:
-            return float(wire)
-    raise ValueError("time_scale's scale must be a number from 0.1 to 1 (simulated seconds per wall second), "
-                     f"got {scale!r}")
-
-
-def _client_name(name):
-    """name, or ValueError: FlatBuffers would refuse a non-string after the socket is open, and the server a
-    longer one, closing the connection."""
-    if not isinstance(name, str):
-        raise ValueError(f"name must be a string of at most {_MAX_NAME_BYTES} bytes in UTF-8, got {name!r}")
-    try:
-        size = len(name.encode())
-    except UnicodeEncodeError:
-        raise ValueError(f"name must be text UTF-8 can encode, got {name!r}") from None
-    if size > _MAX_NAME_BYTES:
-        raise ValueError(f"name must be at most {_MAX_NAME_BYTES} bytes in UTF-8 (the server's limit), got {size} "
-                         f"bytes: {name[:20]!r}...")
-    return name
-
-
 def _server_command(host, port):
     """The command that starts a server answering at host:port: it listens on 127.0.0.1 unless given --bind
     (common/server_hint.h says the same for the viewer)."""
@@ -157,58 +81,6 @@ def _server_command(host, port):
     else:
         bind = " --bind ::" if ":" in host else " --bind 0.0.0.0"
     return f"build/server/fishtank-server{bind} --port {port}"
-
-
-def _vec(v):
-    return np.array([v.X(), v.Y(), v.Z()], dtype=np.float32)
-
-
-def dequantize(q, lo, hi):
-    """protocol/quantize.h's dequantize, in float32 step by step: lo + q * ((hi - lo) / 65535)."""
-    lo = np.asarray(lo, dtype=np.float32)
-    step = (np.asarray(hi, dtype=np.float32) - lo) / _QUANT_STEPS
-    return lo + q.astype(np.float32) * step
-
-
-def _decimal(value):
-    """A float32 the server sent as the shortest decimal that is that float: 0.1 as set, not 0.10000000149011612."""
-    return float(str(np.float32(value)))
-
-
-def _text(raw):
-    """A server's words as str: bytes that are not UTF-8 (a foreign server's) as \\xNN instead of an exception."""
-    return (raw or b"").decode(errors="backslashreplace")
-
-
-def _frame(payload_type, build):
-    b = flatbuffers.Builder(128)
-    payload = build(b)
-    Message.Start(b)
-    Message.AddPayloadType(b, payload_type)
-    Message.AddPayload(b, payload)
-    b.FinishSizePrefixed(Message.End(b), _IDENTIFIER)
-    return bytes(b.Output())
-
-
-def _table(b, module, **fields):
-    module.Start(b)
-    for adder, value in fields.items():
-        getattr(module, adder)(b, value)
-    return module.End(b)
-
-
-def _hello_frame(name, player=False, acknowledges=True):
-    """The Hello a client opens with (also the WebSocket tests' and scripts/figures-web-observers')."""
-    def build(b):
-        text = b.CreateString(name)
-        return _table(b, Hello, AddProtocolVersion=PROTOCOL_VERSION, AddClientName=text,
-                      AddWantsPlayer=bool(player), AddAcknowledges=bool(acknowledges))
-
-    return _frame(Payload.Payload.Hello, build)
-
-
-def _ack_frame(tick, want_keyframe=False):
-    return _frame(Payload.Payload.Ack, lambda b: _table(b, Ack, AddTick=tick, AddWantKeyframe=bool(want_keyframe)))
 
 
 class Client:

@@ -13,7 +13,7 @@ import subprocess
 import pytest
 import websockets
 
-from fishtank.client import _ack_frame, _hello_frame
+from fishtank._frames import _ack_frame, _hello_frame
 from fishtank.wire import Error, ErrorCode, Message, Payload, Snapshot
 
 TOO_BIG = 1009  # RFC 6455: message too big
