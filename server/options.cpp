@@ -35,7 +35,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   PhysicsParams defaults;
   std::int64_t balls = 0, steps = static_cast<std::int64_t>(o.bench_spec.steps);
   std::int64_t threads = threaded ? WorkerPool::hardware_threads() : 1, max_balls = 0, seed = 1;
-  std::int64_t steps_per_contact = defaults.steps_per_contact;
+  std::int64_t steps_per_contact = defaults.steps_per_contact, prefetch_from = defaults.prefetch_from;
   double dt = defaults.dt;  // read wide: a float would take 1e-46 as 0 (automatic) without a word
   double settle_time = 0.0;
   std::int64_t windows = o.bench_spec.windows;
@@ -50,7 +50,10 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "threads", po::value(&threads)->default_value(threads, threaded ? "cores available" : "1"), threads_help.c_str())(
       "fixed-threads", po::bool_switch(&o.fixed_threads),
       "always step on every --threads thread, never on one instead: to time the pool itself")(
-      "seed", po::value(&seed)->default_value(seed), "random seed for spawning, >= 0")(
+      "prefetch-from", po::value(&prefetch_from)->default_value(prefetch_from),
+      "balls from which the SIMD step asks memory for rows ahead, 0 to 1e9 (0: always); results do not change, "
+      "speed does (scripts/figures-prefetch)")("seed", po::value(&seed)->default_value(seed),
+                                               "random seed for spawning, >= 0")(
       "scene", po::value(&o.bench_spec.scene.name)->default_value("tank"), scene_help().c_str())(
       "balls", po::value(&balls),
       "balls of every scene (default: the scene's, 1000 for tank; with --bench, 6000, or as many as the "
@@ -226,6 +229,8 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
     for (const char* flag : {"duration", "status-interval"})
       if (!vm[flag].defaulted())
         return fail(std::string("--") + flag + " paces the server, and --bench runs unpaced for --steps: drop it");
+  if (prefetch_from < 0 || prefetch_from > 1'000'000'000)
+    return fail("--prefetch-from must be between 0 and 1000000000 balls, got " + std::to_string(prefetch_from));
   if (max_balls < 0 || max_balls > 10'000'000)
     return fail("--max-balls must be between 0 and 10000000, got " + std::to_string(max_balls));
   if (!std::isfinite(o.duration) || o.duration < 0.0)
@@ -301,6 +306,7 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
   o.threads = static_cast<int>(threads);
   o.start_balls = static_cast<std::uint32_t>(balls);
   o.max_balls = static_cast<std::uint32_t>(max_balls);
+  o.physics.prefetch_from = static_cast<std::uint32_t>(prefetch_from);
   o.bench_spec.scene.balls = o.start_balls;
   o.bench_spec.scene.seed = static_cast<std::uint64_t>(seed);
   o.bench_spec.scene.max_settle_seconds = settle_time;

@@ -116,6 +116,8 @@ class World {
   std::uint64_t steps() const { return steps_; }
   std::uint64_t rebuilds() const { return rebuilds_; }
   float skin() const { return list_.skin(); }  // the lists' skin now (PhysicsParams::skin)
+  // Whether the SIMD step asks for rows ahead (PrefetchPlan): from PhysicsParams::prefetch_from balls.
+  bool beyond_cache() const { return n_ >= params_.prefetch_from; }
   // Steps whose lists were kept after checking the balls that strayed more than skin / 2 (lists_hold()).
   std::uint64_t lists_kept_by_checks() const { return lists_kept_by_checks_; }
   // Balls checked in those steps and in the steps whose checks found a contact.
@@ -183,12 +185,6 @@ class World {
   void set_ghost();
   // The arrays and the contact model of the next pass; no prefetch plan.
   StepContext context();
-  // Whether the SIMD step asks for rows ahead (PrefetchPlan): from kBeyondCacheBalls balls.
-  bool beyond_cache() const { return n_ >= kBeyondCacheBalls; }
-  // Tunable, not read from the machine: at some 140 bytes a ball the step's arrays (4.5 MiB here)
-  // outgrow a core's private caches and its share of the last level; below it, asking ahead costs
-  // instructions and buys nothing.
-  static constexpr std::uint32_t kBeyondCacheBalls = 32768;
   void derive_velocities() const;
 
   PhysicsParams params_;

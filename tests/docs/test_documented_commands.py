@@ -50,6 +50,7 @@ EXCLUDED = {
     "scripts/figures": "installs gnuplot, sweeps for minutes and rewrites docs/figures/",
     "scripts/headline": "every variant and LAMMPS in three rounds, 3-8 minutes; rewrites docs/figures/ and the tables of README and report",
     "scripts/figures-error-cost": "benchmarks two builds at up to 160 steps per contact, a quarter of an hour; rewrites docs/figures/",
+    "scripts/figures-prefetch": "times the wide scene at up to 100 000 balls, a quarter of an hour; rewrites docs/figures/",
     "scripts/figures-capacity": "six benchmarks of the settled tank, a minute; rewrites docs/figures/",
     "scripts/figures-load": "the loaded benchmark for minutes; rewrites docs/figures/",
     "scripts/figures-perf": "about 12 minutes; rewrites docs/figures/",

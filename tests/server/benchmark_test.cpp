@@ -65,11 +65,12 @@ TEST_CASE("the benchmark report holds every figure asked for, consistent with th
   const nlohmann::json j = time_steps(untuned, spec, settled);
   for (const char* key :
        {"variant", "simd", "threads", "balls", "steps", "seconds", "steps_per_s", "ball_steps_per_s", "dt", "k",
-        "max_overlap", "pile_top", "phase_seconds", "settle", "peak_rss_mib", "crowding_cores"}) {
+        "max_overlap", "pile_top", "phase_seconds", "settle", "peak_rss_mib", "crowding_cores", "prefetch_ahead"}) {
     INFO(key);
     CHECK(j.contains(key));
   }
   CHECK(j["variant"] == "sse");
+  CHECK(j["prefetch_ahead"] == false);  // 300 balls: below PhysicsParams::prefetch_from
   CHECK(j["balls"] == 300);
   CHECK(j["steps"] == 40);
   CHECK(world.steps() == settled.steps + 40);
