@@ -153,8 +153,12 @@ void PhysicsLink::leave(World& world, std::uint32_t client) {
 }
 
 void PhysicsLink::refresh_figures(const World& world, Clock::time_point now) {
-  if (now < next_figures_ && figures_start_ == scene_.start_count()) return;
+  // Paused, with the asked steps done, the state holds until the next command: its figures are measured
+  // at once, or a script stepping faster than the period would read the figures of an earlier step.
+  const bool stepped_to_rest = control_.paused && control_.steps_to_run == 0 && world.steps() != figures_step_;
+  if (now < next_figures_ && figures_start_ == scene_.start_count() && !stepped_to_rest) return;
   figures_start_ = scene_.start_count();
+  figures_step_ = world.steps();
   kinetic_energy_per_ball_ = world.ball_count() ? static_cast<float>(kinetic_energy(world) / world.ball_count()) : 0.0f;
   const ContactFigures contact = contact_figures(world);
   contacts_ = contact.contacts;

@@ -55,7 +55,8 @@ class PhysicsLink {
   // Tells the clients in line from `first` on their place (each has moved up, or just joined).
   void tell_places_from(std::size_t first);
   void publish_snapshot(const World& world, const LoopStatus& status);
-  // Refreshes the plotted figures (energy, contacts) when they are older than kFiguresPeriod.
+  // Refreshes the plotted figures (energy, contacts) when they are older than kFiguresPeriod, the scene
+  // restarted, or paused steps came to an end.
   void refresh_figures(const World& world, Clock::time_point now);
   // The figures pass over every ball and contact on the physics thread while
   // the workers wait: ten times a second is plenty for a plot. A pass that
@@ -86,6 +87,7 @@ class PhysicsLink {
   SnapshotStats stats_;
   Clock::time_point next_figures_ = Clock::now();
   std::uint32_t figures_start_ = 0;  // the scene start they were measured in
+  std::uint64_t figures_step_ = 0;   // and the step
   float kinetic_energy_per_ball_ = 0.0f;
   std::uint32_t contacts_ = 0;
   float max_overlap_ = 0.0f;

@@ -9,6 +9,8 @@
 #include <thread>
 #include <vector>
 
+#include "server/physics/world_measures.h"
+
 using namespace fishtank;
 using namespace fishtank::net;
 
@@ -20,6 +22,7 @@ struct Link {
   RunControl control;
   ActiveScene scene{SceneChoice{"tank", 1, 200, 0}};
   std::vector<Reply> replies;
+  std::vector<SharedSnapshot> published;
   World world;
   PhysicsLink link;
 
@@ -27,7 +30,7 @@ struct Link {
       : world(params(), kSseKernels, 1, 1),
         link(
             queue, viewers, PhysicsLinkOptions{}, control, scene, [this](Reply r) { replies.push_back(std::move(r)); },
-            [](SharedSnapshot) {}) {
+            [this](SharedSnapshot s) { published.push_back(std::move(s)); }) {
     REQUIRE(scene.start(world).empty());
   }
   PhysicsParams params() const {
@@ -101,4 +104,31 @@ TEST_CASE(
     }
   }
   CHECK(refused);
+}
+
+TEST_CASE(
+    "paused, a snapshot after steps carries the energy, contacts and overlap of its own step, however soon "
+    "the steps follow the last figures",
+    "[net][sandbox]") {
+  Link l;
+  l.viewers = 1;
+  l.control.paused = true;
+  const auto snapshot_after = [&l](int steps) {
+    for (int i = 0; i < steps; ++i) l.world.step();              // as the loop runs a Step while paused
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));  // past the next snapshot's time (60 a second)
+    const std::size_t before = l.published.size();
+    l.link.at_step_boundary(l.world, LoopStatus{});
+    REQUIRE(l.published.size() == before + 1);
+    return l.published.back()->header;
+  };
+  snapshot_after(300);  // balls pouring in and falling: the energy changes every step
+  for (int steps : {1, 5, 40}) {
+    INFO(steps << " steps after the last snapshot, well within the figures' period");
+    const protocol::SnapshotHeader h = snapshot_after(steps);
+    const ContactFigures now = contact_figures(l.world);
+    CHECK(h.physics_steps == l.world.steps());
+    CHECK(h.kinetic_energy_per_ball == static_cast<float>(kinetic_energy(l.world) / l.world.ball_count()));
+    CHECK(h.contacts == now.contacts);
+    CHECK(h.max_overlap == now.max_overlap);
+  }
 }
