@@ -7,7 +7,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-_UINT32_MAX = 2**32 - 1  # AddBalls.count, Step.count
+_UINT32_MAX = 2**32 - 1  # AddBalls.count
+_MAX_STEPS = 100_000  # protocol/frame_codec.h: kMaxStepsPerRequest, the most one Step runs
 _UINT64_MAX = 2**64 - 1  # Reset.seed
 _MAX_NAME_BYTES = 64  # protocol/frame_codec.h: kMaxClientNameBytes; the server refuses a longer Hello
 _MIN_TIME_SCALE = np.float32(0.1)  # protocol/frame_codec.h: kMinTimeScale .. kMaxTimeScale

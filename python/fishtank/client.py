@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fishtank._arguments import (_UINT32_MAX, _UINT64_MAX, _client_name, _seconds, _time_scale, _velocity,
+from fishtank._arguments import (_MAX_STEPS, _UINT32_MAX, _UINT64_MAX, _client_name, _seconds, _time_scale, _velocity,
                                  _whole_number)
 from fishtank._frames import (_IDENTIFIER, _MAX_FRAME_BYTES, _ack_frame, _decimal, _frame, _hello_frame, _table,
                               _text, _vec, dequantize)
@@ -211,11 +211,16 @@ class Client:
                              lambda s: not s.paused)
 
     def step(self, n=1):
-        """Runs n steps while paused and returns the snapshot taken once they are done."""
-        n = _whole_number(n, "step's n", 1, _UINT32_MAX)
+        """Runs n steps while paused and returns the snapshot taken once they are done. The timeout counts from
+        the last snapshot that showed steps done: a long step takes as long as its steps need."""
+        n = _whole_number(n, "step's n", 1, _MAX_STEPS)
         before = self._current().physics_steps
+
+        def steps_done(s):
+            return (s.physics_steps - before) % 2**32
+
         return self._control(_frame(Payload.Payload.Step, lambda b: _table(b, Step, AddCount=n)),
-                             lambda s: (s.physics_steps - before) % 2**32 >= n)
+                             lambda s: steps_done(s) >= n, progress=steps_done)
 
     def reset(self, seed=None):
         """Starts the running scene again (with this seed, or the scene's last) and returns its first snapshot."""
@@ -287,13 +292,13 @@ class Client:
 
         return self._control(_frame(Payload.Payload.Reset, build), lambda s: s.scene_start != before)
 
-    def _control(self, frame, done):
+    def _control(self, frame, done, progress=None):
         """Sends a control and returns the first snapshot after it that satisfies done. Its refusal is raised
         here, not by a later call: the round trip waits for it where done holds without the control (a resume
         while running, a step's count run by a running simulation)."""
         self._send(frame)
         self._round_trip()
-        return self._wait_for(done)
+        return self._wait_for(done, progress)
 
     def _send(self, frame):
         """Sends for the caller: a connection that has ended raises why it ended (the server's last Error), not
@@ -357,13 +362,17 @@ class Client:
             self.snapshot()
         return self._decode_snapshot(*self._last)
 
-    def _wait_for(self, done):
-        """Waits for a snapshot that satisfies done (returned), or a refusal from the server (FishtankError)."""
+    def _wait_for(self, done, progress=None):
+        """Waits for a snapshot that satisfies done (returned), or a refusal from the server (FishtankError).
+        Where progress(snapshot) changes, the timeout counts again from that snapshot."""
         deadline = time.monotonic() + self.timeout
+        last = None
         while True:
             s = self._decode_snapshot(*self._wait(self._take_refusal_or_newest, deadline))
             if done(s):
                 return s
+            if progress and (now := progress(s)) != last:
+                last, deadline = now, time.monotonic() + self.timeout
 
     def _round_trip(self):
         """Waits for a Pong, so that any immediate refusal of what was sent before has arrived."""

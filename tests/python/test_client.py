@@ -208,6 +208,19 @@ def test_a_sphere_freed_for_idleness_takes_control_as_the_servers_policy_does_an
                 none.value.message
 
 
+def test_a_step_longer_than_the_timeout_returns_once_done_as_long_as_its_steps_keep_coming(start_server):
+    server = start_server("--balls", "2000")
+    with Client("127.0.0.1", server.port, timeout=1) as tank:
+        paused = tank.pause()
+        started = time.monotonic()
+        stepped = tank.step(100_000)  # seconds of stepping, each snapshot showing more steps done
+        took = time.monotonic() - started
+        assert stepped.physics_steps == (paused.physics_steps + 100_000) % 2**32
+        assert stepped.paused
+        if took <= 1:
+            pytest.skip(f"100000 steps of 2000 balls took {took:.2f} s, within the timeout: nothing to show here")
+
+
 def test_refusals_raise_with_the_servers_reason_and_the_connection_keeps_working(start_server):
     server = start_server("--balls", "50")
     with Client("127.0.0.1", server.port) as tank, Client("127.0.0.1", server.port, player=False) as observer:
@@ -218,8 +231,9 @@ def test_refusals_raise_with_the_servers_reason_and_the_connection_keeps_working
             tank.scene("cube")
         assert unknown.value.code == "invalid_value" and "tank, wide, dam-break and drop" in unknown.value.message
         with pytest.raises(FishtankError) as many:
-            tank.step(100_001)  # the server's limit, not the wire's
-        assert many.value.code == "invalid_value" and "Step.count must be between 1 and 100000" in many.value.message
+            tank.add_balls(100_001)  # the server's limit, not the wire's
+        assert many.value.code == "invalid_value" and "AddBalls.count must be between 1 and 100000" in \
+            many.value.message
         assert not observer.may_control and "observers may not" in observer.control_policy
         with pytest.raises(FishtankError) as refused:
             observer.pause()
@@ -373,7 +387,8 @@ def test_arguments_the_wire_cannot_carry_raise_value_error_at_once_and_the_next_
         reset, scene = (lambda seed: tank.reset(seed=seed)), (lambda seed: tank.scene("drop", seed=seed))
         for call, bad, what, allowed in ((tank.add_balls, 2**32, "add_balls' n", counts),
                                          (tank.add_balls, 2**40, "add_balls' n", counts),
-                                         (tank.step, 2**40, "step's n", counts),
+                                         (tank.step, 100_001, "step's n", "from 1 to 100000"),  # the server's
+                                         (tank.step, 2**40, "step's n", "from 1 to 100000"),
                                          (reset, 2**64, "seed", seeds), (reset, 2**70, "seed", seeds),
                                          (scene, 2**64, "seed", seeds)):
             with pytest.raises(ValueError) as refused:
