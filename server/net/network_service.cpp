@@ -8,18 +8,14 @@
 #include <cstdio>
 #include <cstring>
 
+#include "common/cpu_clock.h"
 #include "server/net/machine_addresses.h"
 
 namespace fishtank::net {
 
 namespace {
 
-double cpu_seconds(clockid_t clock) {
-  timespec t{};
-  return clock_gettime(clock, &t) == 0 ? t.tv_sec + 1e-9 * t.tv_nsec : 0.0;
-}
-
-double thread_cpu_seconds(std::thread& thread) {
+double cpu_seconds_of(std::thread& thread) {
   clockid_t clock;
   return pthread_getcpuclockid(thread.native_handle(), &clock) == 0 ? cpu_seconds(clock) : 0.0;
 }
@@ -112,7 +108,7 @@ std::string NetworkService::status() {
   const double window = std::chrono::duration<double>(now - last_status_).count();
   const std::uint64_t bytes = server_.total_bytes_sent();
   const std::uint64_t skipped = server_.total_snapshots_skipped();
-  const double io_cpu = io_thread_.joinable() ? thread_cpu_seconds(io_thread_) : 0.0;
+  const double io_cpu = io_thread_.joinable() ? cpu_seconds_of(io_thread_) : 0.0;
   const double process_cpu = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID);
   const SnapshotStats& snapshots = link_.snapshot_stats();
   const FrameStats& frames = server_.frame_stats();
@@ -121,8 +117,9 @@ std::string NetworkService::status() {
   const double coding_seconds = 1e-9 * static_cast<double>(frames.coding_ns.load(std::memory_order_relaxed));
   const std::uint64_t frame_bytes = frames.frame_bytes.load(std::memory_order_relaxed);
 
-  // Networking = the io thread (which codes the frames) plus the capture on the physics thread.
-  const double net_cpu = (io_cpu - last_io_cpu_) + (snapshots.encode_seconds - last_encode_seconds_);
+  // Networking = the io thread (which codes the frames) plus the capture on the physics thread, in CPU time
+  // both: the capture's wall time also counts the moments a busy machine kept the thread waiting.
+  const double net_cpu = (io_cpu - last_io_cpu_) + (snapshots.encode_cpu_seconds - last_encode_cpu_seconds_);
   const double process = process_cpu - last_process_cpu_;
   const std::uint64_t encoded = snapshots.encoded - last_encoded_;
   const std::uint64_t coded = frames_coded - last_frames_;
@@ -151,6 +148,7 @@ std::string NetworkService::status() {
   last_io_cpu_ = io_cpu;
   last_process_cpu_ = process_cpu;
   last_encode_seconds_ = snapshots.encode_seconds;
+  last_encode_cpu_seconds_ = snapshots.encode_cpu_seconds;
   last_encoded_ = snapshots.encoded;
   last_frames_ = frames_coded;
   last_keyframes_ = keyframes;

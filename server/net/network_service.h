@@ -69,7 +69,7 @@ class NetworkService {
   std::chrono::steady_clock::time_point last_status_ = std::chrono::steady_clock::now();
   std::uint64_t last_bytes_ = 0;
   std::uint64_t last_skipped_ = 0;
-  double last_io_cpu_ = 0.0, last_process_cpu_ = 0.0, last_encode_seconds_ = 0.0;
+  double last_io_cpu_ = 0.0, last_process_cpu_ = 0.0, last_encode_seconds_ = 0.0, last_encode_cpu_seconds_ = 0.0;
   std::uint64_t last_encoded_ = 0;
   std::uint64_t last_frames_ = 0, last_keyframes_ = 0, last_frame_bytes_ = 0;
   double last_coding_seconds_ = 0.0;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <string>
 
+#include "common/cpu_clock.h"
 #include "server/physics/world_measures.h"
 
 namespace fishtank::net {
@@ -168,6 +169,7 @@ void PhysicsLink::refresh_figures(const World& world, Clock::time_point now) {
 
 void PhysicsLink::publish_snapshot(const World& world, const LoopStatus& status) {
   const Clock::time_point start = Clock::now();
+  const double cpu_start = thread_cpu_seconds();
   protocol::SnapshotHeader header;
   header.tick = tick_++;
   header.sim_time = world.time();
@@ -187,6 +189,7 @@ void PhysicsLink::publish_snapshot(const World& world, const LoopStatus& status)
   header.max_overlap = max_overlap_;
   SharedSnapshot snapshot = encoder_.encode(world, header);
   stats_.encode_seconds += std::chrono::duration<double>(Clock::now() - start).count();
+  stats_.encode_cpu_seconds += thread_cpu_seconds() - cpu_start;
   ++stats_.encoded;
   publish_(std::move(snapshot));
 }

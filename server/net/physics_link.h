@@ -32,7 +32,8 @@ struct PhysicsLinkOptions {
 // Measured on the physics thread; read there too (the status line).
 struct SnapshotStats {
   std::uint64_t encoded = 0;
-  double encode_seconds = 0.0;  // total, of the capture (quantisation) only
+  double encode_seconds = 0.0;      // total, of the capture (quantisation) only
+  double encode_cpu_seconds = 0.0;  // the same in the physics thread's CPU time
 };
 
 class PhysicsLink {

@@ -132,3 +132,15 @@ TEST_CASE(
     CHECK(h.max_overlap == now.max_overlap);
   }
 }
+
+TEST_CASE("a snapshot's capture is counted in CPU time too, for the status line's net cpu, never above its wall time",
+          "[net]") {
+  Link l;
+  l.viewers = 1;
+  for (int i = 0; i < 200; ++i) l.world.step();
+  l.link.at_step_boundary(l.world, LoopStatus{});
+  const SnapshotStats& stats = l.link.snapshot_stats();
+  REQUIRE(stats.encoded == 1);
+  CHECK(stats.encode_cpu_seconds > 0.0);
+  CHECK(stats.encode_cpu_seconds <= stats.encode_seconds + 1e-4);  // the two clocks' resolution apart
+}
