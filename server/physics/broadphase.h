@@ -208,7 +208,8 @@ inline void for_each_range_within_reach(const ListBuild& b, CellCoord c, Float4 
   for (int dz = 0; dz < 3; ++dz) {
     for (int dy = 0; dy < 3; ++dy) {
       const float gap_yz = gap_y[dy] + gap_z[dz];
-      if (gap_yz >= reach2) continue;
+      // Not `>=`: a ball whose position is NaN has NaN gaps, and must not reach past the grid's edge.
+      if (!(gap_yz < reach2)) continue;
       const std::ptrdiff_t row = (dz - 1) * z_step + (dy - 1) * y_step;
       const bool with_left = gap_yz + gx.below2 < reach2, with_right = gap_yz + gx.above2 < reach2;
       if (with_left && !left_joined) visit(left[row], left[row + 1]);
