@@ -9,6 +9,7 @@ import { OrbitCamera } from './camera';
 import { Input, sandboxFrames } from './controls';
 import { Hud } from './hud';
 import { Connection } from './net';
+import { RateWindow } from './rate_window';
 import { Renderer } from './render';
 import type { Player } from './snapshots';
 import * as wire from './wire';
@@ -57,10 +58,7 @@ const hud = new Hud(overlay);
 let framed = '';  // the tank the camera was framed for: again only when a scene's tank differs
 let kindsOf: unknown = null;
 let showTank = true;
-let frames = 0;
-let fps = 0;
-let frameMs = 0;
-let fpsStarted = performance.now();
+const frameRate = new RateWindow(performance.now() / 1000);
 let ownPlayer: Player | null = null;
 let drawnBalls = 0;
 let framesDrawn = 0;
@@ -114,22 +112,21 @@ function frame(nowMs: number): void {
   drawnBalls = pair ? pair.to.ballCount : 0;
   if (renderer) {  // frames count only where a picture is drawn (none while the context is lost)
     renderer.draw(camera.viewProjection(canvas.width / Math.max(1, canvas.height)), pair, players, own, showTank);
-    ++frames;
+    frameRate.add();
     ++framesDrawn;
   }
-  const elapsed = nowMs - fpsStarted;
-  if (elapsed >= 500) {
-    fps = (1000 * frames) / elapsed;
-    frameMs = frames > 0 ? elapsed / frames : 0;
-    frames = 0;
-    fpsStarted = nowMs;
-  }
-  hud.update(net, { fps, frameMs, now, renderDelayMs: 1000 * net.snapshots.renderDelay(), observerAsked,
+  frameRate.close(now, 0.5);
+  hud.update(net, { fps: frameRate.perSecond, frameMs: 1000 * frameRate.meanGap, now,
+                    renderDelayMs: 1000 * net.snapshots.renderDelay(), observerAsked,
                     webgl: restoreProblem || (contextLost ? CONTEXT_LOST : webglProblem) });
   requestAnimationFrame(frame);
 }
 requestAnimationFrame(frame);
-document.addEventListener('visibilitychange', () => net.setVisible(document.visibilityState !== 'hidden'));
+document.addEventListener('visibilitychange', () => {
+  const visible = document.visibilityState !== 'hidden';
+  if (visible) frameRate.restart(performance.now() / 1000);
+  net.setVisible(visible);
+});
 net.setVisible(document.visibilityState !== 'hidden');
 
 // What the browser tests (tests/web) read; plain values, so page.evaluate can return them.
@@ -154,7 +151,7 @@ net.setVisible(document.visibilityState !== 'hidden');
     decodeMs: net.decodeMs,
     framesDrawn,
     bytes: net.bytes,
-    fps,
+    fps: frameRate.perSecond,
     cameraDistance: camera.distanceToTarget(),
     touchPadShown: !document.querySelector<HTMLElement>('.touchpad')!.hidden,
     touchStickShown: !document.querySelector<HTMLElement>('.touchpad .stick')!.hidden,

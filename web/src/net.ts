@@ -10,6 +10,7 @@ import {
 import { ReceivedSnapshots } from './delta';
 import type { BallKind } from './render';
 import { Frame, Player, SnapshotBuffer } from './snapshots';
+import { RateWindow } from './rate_window';
 import * as wire from './wire';
 
 const INPUT_PERIOD_MS = 1000 / 30;
@@ -48,8 +49,6 @@ export class Connection {
   info: ServerInfo | null = null;
   readonly snapshots = new SnapshotBuffer();
   lastUpdate = -1;  // seconds() of the newest snapshot, -1 before any
-  snapshotsPerS = 0;
-  bytesPerS = 0;
   rttMs = -1;
   // Counted for the tests and the curious: decoded deltas, keyframes asked for, connections made.
   deltas = 0;
@@ -71,9 +70,8 @@ export class Connection {
   private readonly received = new ReceivedSnapshots();
   private inputSequence = 0;
   private hiddenTimer: ReturnType<typeof setTimeout> | undefined;
-  private snapshotsThisSecond = 0;
-  private bytesThisSecond = 0;
-  private secondStarted = seconds();
+  private readonly snapshotRate = new RateWindow(seconds());
+  private readonly byteRate = new RateWindow(seconds());
 
   // velocity() is sampled at each input tick, not per drawn frame: a slow or
   // hidden tab draws few frames but still steers.
@@ -89,11 +87,24 @@ export class Connection {
     return this.notice && seconds() - this.noticeTime < NOTICE_SECONDS ? this.notice : '';
   }
 
+  get snapshotsPerS(): number {
+    return this.snapshotRate.perSecond;
+  }
+
+  get bytesPerS(): number {
+    return this.byteRate.perSecond;
+  }
+
   // The page shown or hidden (document.visibilityState).
   setVisible(visible: boolean): void {
     clearTimeout(this.hiddenTimer);
-    if (visible) this.watch(true);
-    else this.hiddenTimer = setTimeout(() => this.watch(false), HIDDEN_GRACE_MS);
+    if (!visible) {
+      this.hiddenTimer = setTimeout(() => this.watch(false), HIDDEN_GRACE_MS);
+      return;
+    }
+    this.watch(true);
+    this.snapshotRate.restart(seconds());
+    this.byteRate.restart(seconds());
   }
 
   private watch(on: boolean): void {
@@ -125,7 +136,7 @@ export class Connection {
     socket.onopen = () => socket.send(wire.hello(this.name, this.wantsPlayer));
     socket.onmessage = (e: MessageEvent) => {
       if (socket !== this.socket || !(e.data instanceof ArrayBuffer)) return;
-      this.bytesThisSecond += e.data.byteLength;
+      this.byteRate.add(e.data.byteLength);
       this.bytes += e.data.byteLength;
       const m = wire.readMessage(e.data);
       if (!m) return this.lose('the server sent something that is not a Fishtank message');
@@ -307,7 +318,7 @@ export class Connection {
     this.decodeMs += performance.now() - started;
     ++this.decoded;
     this.lastUpdate = f.received;
-    ++this.snapshotsThisSecond;
+    this.snapshotRate.add();
   }
 
   private sendInput(): void {
@@ -316,11 +327,8 @@ export class Connection {
 
   private everySecond(): void {
     const now = seconds();
-    const span = now - this.secondStarted;
-    this.snapshotsPerS = this.snapshotsThisSecond / span;
-    this.bytesPerS = this.bytesThisSecond / span;
-    this.snapshotsThisSecond = this.bytesThisSecond = 0;
-    this.secondStarted = now;
+    this.snapshotRate.close(now);
+    this.byteRate.close(now);
     this.send(wire.ping(Math.round(now * 1e6) >>> 0));
   }
 }
