@@ -177,7 +177,7 @@ test('holding D moves the player sphere to the camera\'s right (+x at the start)
   assert.ok(Math.abs(moved.pos[2] - start.pos[2]) < 0.5, `not along z: ${JSON.stringify([start, moved])}`);
 });
 
-test('on a touch screen a pad appears at the first touch: a pinch zooms, the stick moves the sphere forward, +1000 pours balls; on its side the statistics leave the pile in view', async () => {
+test('on a touch screen a pad appears at the first touch: a pinch zooms, the stick moves the sphere forward, +1000 pours balls, ? opens a help a tap closes; on its side the statistics leave the pile in view', async () => {
   const phone = await browser.newPage();
   phone.on('pageerror', (e) => pageErrors.push(String(e)));
   await phone.setViewport({ width: 420, height: 640, hasTouch: true, isMobile: true });
@@ -220,6 +220,32 @@ test('on a touch screen a pad appears at the first touch: a pinch zooms, the sti
   });
   await phone.touchscreen.tap(add[0], add[1]);
   await waitForState(phone, (st) => st.serverBalls >= before + 1000, `${before + 1000} balls`);
+
+  // ? opens the help over the pad's buttons, ? among them; a tap on the help closes it.
+  const centre = (selector, text) => phone.$$eval(selector, (es, t) => {
+    const e = es.find((x) => t === undefined || x.textContent === t);
+    const r = e.getBoundingClientRect();
+    return [r.x + r.width / 2, r.y + r.height / 2];
+  }, text);
+  const question = await centre('.touchpad button', '?');
+  await phone.touchscreen.tap(question[0], question[1]);
+  await phone.waitForFunction(() => !document.getElementById('help').hidden, { timeout: 10000 });
+  // Where a button of the pad lies under the help, the help is what shows there.
+  const covered = await phone.evaluate(() => {
+    const h = document.getElementById('help').getBoundingClientRect();
+    return [...document.querySelectorAll('.touchpad button')].map((b) => b.getBoundingClientRect())
+      .filter((r) => r.bottom > h.top + 1 && r.top < h.bottom - 1 && r.right > h.left + 1 && r.left < h.right - 1)
+      .map((r) => {
+        const x = (Math.max(r.left, h.left) + Math.min(r.right, h.right)) / 2;
+        const y = (Math.max(r.top, h.top) + Math.min(r.bottom, h.bottom)) / 2;
+        return document.elementFromPoint(x, y)?.closest('#help') !== null;
+      });
+  });
+  assert.ok(covered.length > 0, 'the help reaches over the pad\'s buttons on a phone held upright');
+  assert.ok(covered.every(Boolean), `the help is drawn above the pad's buttons: ${JSON.stringify(covered)}`);
+  const help = await centre('#help');
+  await phone.touchscreen.tap(help[0], help[1]);
+  await phone.waitForFunction(() => document.getElementById('help').hidden, { timeout: 10000 });
 
   // Turned on its side, the statistics take two columns across the top and leave the pile in view.
   await phone.setViewport({ width: 844, height: 390, hasTouch: true, isMobile: true });

@@ -26,7 +26,7 @@ const HELP: [string, string][] = [
   ['F1', 'show / hide the statistics'],
   ['H', 'show / hide this help'],
   ['Touch', 'drag: orbit; pinch: zoom; the stick moves your sphere, ▲ ▼ raise and lower it,'],
-  ['', '+1000, HUD and ? stand for B, F1 and H'],
+  ['', '+1000, HUD and ? stand for B, F1 and H; a tap on this help closes it'],
 ];
 
 export interface HudView {
@@ -62,6 +62,7 @@ export class Hud {
     const title = document.createElement('h2');
     title.textContent = 'Controls';
     this.help.append(title, table);
+    this.help.addEventListener('click', () => (this.help.hidden = true));  // on a touch screen it covers the ? button
     root.append(this.stats, this.alerts, this.help);
   }
 
