@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <string>
 
 namespace fishtank {
 
@@ -18,10 +19,11 @@ namespace {
 std::string write_access(const fs::path& path) { return ::access(path.c_str(), W_OK) == 0 ? "" : std::strerror(errno); }
 
 // "" where a new file can be made at path, otherwise the reason. The file is made and removed again:
-// access(2) on its folder passes for root, and in /proc, where no file can be made.
+// access(2) on its folder passes for root, and in /proc, where no file can be made. Where something
+// appeared there meanwhile (another run's file, a dangling link), the write itself will tell.
 std::string trial_create(const fs::path& path) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
-  if (fd < 0) return std::strerror(errno);
+  if (fd < 0) return errno == EEXIST ? "" : std::strerror(errno);
   ::close(fd);
   ::unlink(path.c_str());
   return "";
@@ -44,7 +46,8 @@ std::string prepare_writable_folder(const std::string& dir) {
   fs::create_directories(dir, ec);
   if (ec) return "cannot create " + dir + ": " + ec.message();
   if (!fs::is_directory(dir, ec)) return dir + " is a file, not a folder";
-  const std::string denied = trial_create(fs::path(dir) / ".fishtank-write-trial");
+  // Named for this process: two runs checking one folder at once do not meet.
+  const std::string denied = trial_create(fs::path(dir) / (".fishtank-write-trial-" + std::to_string(::getpid())));
   return denied.empty() ? "" : "cannot write in " + dir + ": " + denied;
 }
 

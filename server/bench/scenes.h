@@ -28,7 +28,7 @@ SettleReport settle(TunedStepper& stepper, const SceneSpec& spec);
 // a frictionless ball can slide along the floor for minutes.
 inline constexpr double kRestEnergy = 1e-6;  // J per ball
 
-// A soft pile can dip under kRestEnergy and swing back: rest is half a second of it.
+// A soft pile can dip under kRestEnergy and swing back: rest is this many checks in a row.
 inline constexpr int kRestChecks = 5;
 
 // Counts the checks in a row that found the pile at rest.

@@ -48,6 +48,18 @@ TEST_CASE(
   CHECK(watch.settled(true));
 }
 
+TEST_CASE("settle() stops at kRestChecks checks at rest, not at the first: an empty tank rests from the start",
+          "[bench]") {
+  SceneSpec spec;
+  spec.balls = 0;
+  World world(PhysicsParams{}, kSseKernels, 1, spec.seed);
+  TunedStepper untuned(world, false);
+  const SettleReport report = settle(untuned, spec);
+  REQUIRE(report.settled);
+  const double check = std::floor(0.1 / world.dt()) * world.dt();  // checks a whole number of steps apart
+  CHECK(report.sim_seconds == Approx(kRestChecks * check).margin(1e-9));
+}
+
 TEST_CASE("the benchmark report holds every figure asked for, consistent with the run", "[bench]") {
   BenchSpec spec;
   spec.scene.balls = 300;

@@ -100,6 +100,7 @@ def test_output_paths_that_cannot_be_written_are_refused_before_anything_runs(tm
         ("--export-lammps", str(a_file / "lammps")): "cannot create",
         # /proc lets root pass access(2) yet makes no file: only making one tells.
         ("--dump", "/proc/fishtank-final.csv"): "cannot write /proc/fishtank-final.csv: No such file or directory",
+        ("--export-lammps", "/proc/self"): "cannot write in /proc/self: ",  # a folder that exists
     }
     for (flag, path), why in refusals.items():
         for mode in (["--bench", "--balls", "200", "--steps", "100"], ["--port", "0", "--no-web", "--duration", "5"]):
