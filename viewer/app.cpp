@@ -13,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "common/cpu_clock.h"
 #include "common/host_port.h"
 #include "common/server_hint.h"
 #include "viewer/clock.h"
@@ -72,7 +73,9 @@ void on_glfw_error(int code, const char* description) {
 
 class FullscreenToggle {
  public:
-  explicit FullscreenToggle(GLFWwindow* window) : window_(window) {}
+  FullscreenToggle(GLFWwindow* window, bool full_screen) : window_(window) {
+    if (full_screen) toggle();
+  }
   void toggle() {
     if (glfwGetWindowMonitor(window_)) {
       glfwSetWindowMonitor(window_, nullptr, x_, y_, kWindowWidth, kWindowHeight, 0);
@@ -178,15 +181,11 @@ class Viewer {
       : opt_(opt),
         window_(window),
         pacer_(announced_pacer(opt)),
-        fullscreen_(window),
+        fullscreen_(window, opt.fullscreen),  // before the HUD and input are made, as the window they see
         input_(window),
         hud_(window),
         net_(opt.host, opt.port, !opt.observer, snapshots_) {
-    if (opt.fullscreen) fullscreen_.toggle();
     camera_.frame(TankBounds{});
-    hud_view_.observer = opt.observer;
-    hud_view_.show_stats = hud_view_.show_plots = opt.hud;
-    hud_view_.plots = &plots_;
     glEnable(GL_DEPTH_TEST);
     glEnable(GL_CULL_FACE);
     glClearColor(0.055f, 0.066f, 0.09f, 1.0f);
@@ -248,10 +247,10 @@ class Viewer {
     if (a.quit || (opt_.duration > 0.0 && now - started_ >= opt_.duration))
       glfwSetWindowShouldClose(window_, GLFW_TRUE);
     if (a.toggle_tank) show_tank_ = !show_tank_;
-    if (a.toggle_help) hud_view_.show_help = !hud_view_.show_help;
-    if (a.toggle_hud) hud_view_.show_stats = !hud_view_.show_stats;
+    if (a.toggle_help) show_help_ = !show_help_;
+    if (a.toggle_hud) show_stats_ = !show_stats_;
     if (a.toggle_fullscreen) fullscreen_.toggle();
-    if (a.toggle_plots) hud_view_.show_plots = !hud_view_.show_plots;
+    if (a.toggle_plots) show_plots_ = !show_plots_;
     if (a.add_balls) net_.add_balls(kBallsPerPress);
     for (protocol::Frame& frame : sandbox_frames(a.sandbox, newest)) net_.send_command(std::move(frame));
     if (newest) plots_.add(*newest);
@@ -287,15 +286,23 @@ class Viewer {
 
   void build_hud(double now, const ConnectionStatus& status, const std::string& advice,
                  const Snapshot* newest) {
-    hud_view_.fps = stats_.fps();
-    hud_view_.frame_ms = stats_.frame_ms();
-    hud_view_.cpu_ms = stats_.cpu_ms();
-    hud_view_.net = &status;
-    hud_view_.connection_advice = advice;
-    hud_view_.snapshot = newest;
-    hud_view_.render_delay_ms = static_cast<float>(1e3 * snapshots_.render_delay());
-    hud_view_.now = now;
-    hud_.build(hud_view_);
+    HudView view;
+    view.fps = stats_.fps();
+    view.frame_ms = stats_.frame_ms();
+    view.cpu_ms = stats_.cpu_ms();
+    view.net = &status;
+    view.connection_advice = advice;
+    view.snapshot = newest;
+    view.render_delay_ms = static_cast<float>(1e3 * snapshots_.render_delay());
+    view.observer = opt_.observer;
+    view.show_stats = show_stats_;
+    view.show_help = show_help_;
+    view.show_plots = show_plots_;
+    view.plots = &plots_;
+    view.viewer_notice = notice_;
+    view.viewer_notice_time = notice_time_;
+    view.now = now;
+    hud_.build(view);
   }
 
   void draw(int width, int height, int own) {
@@ -323,10 +330,10 @@ class Viewer {
   // F12: a new file each time, and a notice on screen and in the terminal.
   void save_typed_screenshot(double now, int width, int height) {
     const std::string path = new_screenshot_path();
-    hud_view_.viewer_notice = save_screenshot(path, width, height) ? "screenshot saved: " + path
-                                                                   : "could not save a screenshot at " + path;
-    hud_view_.viewer_notice_time = now;
-    std::fprintf(stderr, "fishtank-viewer: %s\n", hud_view_.viewer_notice.c_str());
+    notice_ = save_screenshot(path, width, height) ? "screenshot saved: " + path
+                                                   : "could not save a screenshot at " + path;
+    notice_time_ = now;
+    std::fprintf(stderr, "fishtank-viewer: %s\n", notice_.c_str());
   }
 
   // --screenshot: saved after --frames frames with the scene, then the viewer closes; or it gives up.
@@ -357,8 +364,10 @@ class Viewer {
   OrbitCamera camera_;
   FrameStats stats_;
   LivePlots plots_;
-  HudView hud_view_;  // the toggles and the notice last from frame to frame
-  bool show_tank_ = opt_.tank_outline;
+  bool show_tank_ = opt_.tank_outline, show_help_ = false, show_stats_ = opt_.hud, show_plots_ = opt_.hud;
+  std::string
+      notice_;  // the viewer's own news (a screenshot saved), shown for a few seconds from notice_time_
+  double notice_time_ = -1.0;
   std::vector<SphereInstance> instances_;
   TankBounds framed_;  // the camera frames the tank again only if a server's tank differs
   int frames_since_snapshot_ = 0;

@@ -2,9 +2,10 @@
 // The viewer's main thread: the window, the frame loop, and the wiring of
 // net client, interpolation, renderers, HUD and input.
 //
-// One frame:  poll input ► pick the snapshot pair for now ► interpolate into
-// instances ► lay out the HUD ─ (CPU above, GL below) ─► draw spheres, outline,
-// tank edges, HUD ► swap.
+// One frame (Viewer::frame):  poll input ► (minimised: wait for events) ► pick
+// the snapshot pair for now ► interpolate into instances ► lay out the HUD
+// ─ (CPU above, GL below) ─► draw spheres, the own sphere's ring, tank edges,
+// HUD ► screenshots (F12, --screenshot) ► swap.
 
 #include <string>
 

@@ -2,11 +2,8 @@
 // One time base for the whole viewer: seconds on the steady clock, shared by
 // the net thread (snapshot arrival, round trips) and the render thread
 // (frame times, interpolation), so their times can be compared directly.
-// The thread's CPU clock (common/cpu_clock.h) gives the cost of a frame's work outside GL.
 
 #include <chrono>
-
-#include "common/cpu_clock.h"
 
 namespace fishtank::viewer {
 
