@@ -113,12 +113,13 @@ struct WideRun {
 // default balls from which the world's step asks for rows ahead
 // (PhysicsParams::prefetch_from), for the rows at the chunks' edges and for
 // the rows across the blocks' faces.
-WideRun run_wide(int threads, std::uint32_t prefetch_from = PhysicsParams{}.prefetch_from) {
+WideRun run_wide(int threads, std::uint32_t prefetch_from = PhysicsParams{}.prefetch_from,
+                 const Kernels& kernels = kSseKernels) {
   PhysicsParams params;
   params.prefetch_from = prefetch_from;
   params.tank.min = {-101.0f, 0.0f, -101.0f};
   params.tank.max = {101.0f, 32.0f, 101.0f};
-  World world(params, kSseKernels, threads, 99);
+  World world(params, kernels, threads, 99);
   constexpr int kSide = 66;
   for (int b = 0; b < 40000; ++b) {
     Vec3 p{-100.0f + 3.05f * (b % kSide), 1.6f + 3.05f * (b / (kSide * kSide)),
@@ -146,6 +147,10 @@ TEST_CASE("a pile beyond the caches is bit-identical for 1 and 2 threads, its re
   const WideRun unasked = run_wide(2, 1'000'000'000);
   CHECK(unasked.hash == one.hash);
   CHECK(unasked.remote_lines == 0);  // nothing noted for a step that asks for nothing
+  if (cpu_has_avx2()) {
+    INFO("AVX2");
+    CHECK(run_wide(2, 1'000'000'000, kAvx2Kernels).hash == run_wide(2, 0, kAvx2Kernels).hash);
+  }
 }
 
 namespace {
