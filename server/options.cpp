@@ -116,8 +116,8 @@ ParseResult parse_server_options(int argc, const char* const argv[], const char*
       "idle-timeout", po::value(&limits.idle_timeout_s)->default_value(limits.idle_timeout_s),
       "seconds a client may go without reading what it is sent: idle_timeout if it sent nothing either, "
       "too_slow if it did")("player-idle", po::value(&limits.player_idle_s)->default_value(limits.player_idle_s),
-                            "seconds a player sphere may stand unmoved before it is freed and its client "
-                            "observes (player_idle); 0: never")(
+                            "seconds a player sphere may stand unmoved, its client sending no control or "
+                            "AddBalls, before it is freed and its client observes (player_idle); 0: never")(
       "max-commands", po::value(&limits.max_commands_per_s)->default_value(limits.max_commands_per_s),
       "messages a second per client, as many in a burst; more: command_flood and a disconnect")(
       "add-rights", po::value(&add_rights)->default_value(add_rights),

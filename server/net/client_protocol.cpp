@@ -119,11 +119,12 @@ Outcome ClientProtocol::on_message(const wire::Message& message, Clock::time_poi
       return refuse(wire::ErrorCode::unexpected_message, "Hello was already received; message ignored", false);
     case wire::Payload::PlayerInput: {
       const wire::Vec3f& v = *message.payload_as_PlayerInput()->velocity();
-      if (v.x() != 0.0f || v.y() != 0.0f || v.z() != 0.0f) last_move_ = now;
+      if (v.x() != 0.0f || v.y() != 0.0f || v.z() != 0.0f) last_used_ = now;
       out.command = Command{client_id_, SetVelocityCommand{{v.x(), v.y(), v.z()}}};
       return out;
     }
     case wire::Payload::AddBalls:
+      last_used_ = now;  // a script that pours, pauses and steps is there, though its sphere stands still
       return on_add_balls(message.payload_as_AddBalls()->count(), now);
     case wire::Payload::Ping:
       out.replies.push_back(protocol::encode_pong(message.payload_as_Ping()->client_time_us()));
@@ -132,6 +133,7 @@ Outcome ClientProtocol::on_message(const wire::Message& message, Clock::time_poi
     case wire::Payload::Step:
     case wire::Payload::Reset:
     case wire::Payload::SetTimeScale:
+      last_used_ = now;
       return on_control(message);
     case wire::Payload::Watching:
       watching_ = message.payload_as_Watching()->on();
@@ -206,14 +208,15 @@ Outcome ClientProtocol::on_add_balls(std::uint32_t count, Clock::time_point now)
 
 std::optional<ClientProtocol::Clock::time_point> ClientProtocol::player_idle_deadline() const {
   if (!has_player_ || info_.limits.player_idle_s <= 0.0) return std::nullopt;
-  return last_move_ + limit_duration(info_.limits.player_idle_s);
+  return last_used_ + limit_duration(info_.limits.player_idle_s);
 }
 
 Outcome ClientProtocol::on_player_idle() {
   has_player_ = false;
   Outcome out = refuse(wire::ErrorCode::player_idle,
-                       "your player sphere did not move for " + seconds_text(info_.limits.player_idle_s) +
-                           " (--player-idle) and was freed for others; you are observing now",
+                       "your player sphere did not move, and you sent no control, for " +
+                           seconds_text(info_.limits.player_idle_s) +
+                           " (--player-idle); it was freed for others and you are observing now",
                        /*disconnect=*/false);
   // Leave removes only the sphere; the connection stays.
   out.command = Command{client_id_, LeaveCommand{}};
@@ -272,7 +275,7 @@ Outcome ClientProtocol::on_reply(const Reply& reply) {
     w.may_control = may_control(info_.control, has_player_);
     w.observers_may_control = may_control(info_.control, false);
     out.replies.push_back(protocol::encode_welcome(w));
-    last_move_ = Clock::now();
+    last_used_ = Clock::now();
     if (!joined->refusal.empty())
       out.replies.push_back(protocol::encode_error(wire::ErrorCode::player_limit, joined->refusal));
     out.log = joined->player_id
@@ -283,7 +286,7 @@ Outcome ClientProtocol::on_reply(const Reply& reply) {
   }
   if (const auto* granted = std::get_if<PlayerGrantedReply>(&reply.result)) {
     has_player_ = true;
-    last_move_ = Clock::now();
+    last_used_ = Clock::now();
     out.replies.push_back(protocol::encode_player_granted(granted->player_id, may_control(info_.control, true)));
     out.log = "given player sphere " + std::to_string(granted->player_id) + ", freed by another client";
     return out;

@@ -8,7 +8,7 @@
 //
 // It also enforces the per-client limits that need no clock of its own
 // (client_limits.h): the first frame's size, the command rate, who may add
-// balls and how many, and when an unmoved player sphere is freed.
+// balls and how many, and when a player sphere neither moved nor used is freed.
 
 #include <chrono>
 #include <cstdint>
@@ -74,7 +74,7 @@ class ClientProtocol {
   Outcome on_reply(const Reply& reply);
   // The command of an Outcome could not be queued (the physics is behind).
   Outcome on_queue_full();
-  // The player sphere has not moved since player_idle_deadline(): it is freed
+  // The player sphere was neither moved nor used by player_idle_deadline(): it is freed
   // (Leave) and the client observes from now on.
   Outcome on_player_idle();
   // The session's clock-driven limits, each an Error and a disconnect:
@@ -112,7 +112,8 @@ class ClientProtocol {
   bool hello_received() const { return state_ != State::awaiting_hello; }
   bool has_player() const { return has_player_; }
   const std::string& client_name() const { return name_; }
-  // When the sphere will be freed unless it moves; empty without a sphere or with --player-idle 0.
+  // When the sphere will be freed unless it moves or a control comes; empty without a sphere or with
+  // --player-idle 0.
   std::optional<Clock::time_point> player_idle_deadline() const;
 
  private:
@@ -134,7 +135,8 @@ class ClientProtocol {
   std::string name_;
   bool has_player_ = false;
   bool watching_ = true;
-  Clock::time_point last_move_;  // the last PlayerInput with a non-zero velocity, or the Welcome
+  // The last PlayerInput with a non-zero velocity, control or AddBalls, or the Welcome.
+  Clock::time_point last_used_;
   RateBudget commands_;
   RateBudget ack_budget_;  // twice the snapshot rate: an Ack per snapshot, and room for a late burst
   RateBudget balls_;

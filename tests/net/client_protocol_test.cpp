@@ -146,3 +146,32 @@ TEST_CASE("an Error code ends the connection (protocol::ends_connection) exactly
   }
   CHECK(disconnects == 11);
 }
+
+TEST_CASE(
+    "a player who pauses, steps or pours keeps the sphere past --player-idle, which Pings and still inputs do not",
+    "[net]") {
+  net::ServerInfo info;
+  info.limits.player_idle_s = 120.0;
+  info.limits.max_commands_per_s = 1000.0;
+  net::ClientProtocol client(1, info);
+  const protocol::Frame hello = protocol::encode_hello("script", true, false);
+  client.on_frame(hello.data(), hello.size());
+  client.on_reply({1, net::JoinedReply{3, ""}});
+  REQUIRE(client.has_player());
+  const auto welcomed_deadline = client.player_idle_deadline();
+  REQUIRE(welcomed_deadline);
+  const std::chrono::seconds idle(120);
+  auto t = *welcomed_deadline - idle;  // the Welcome
+  for (const protocol::Frame& use :
+       {protocol::encode_pause(true), protocol::encode_step(10), protocol::encode_add_balls(5),
+        protocol::encode_set_time_scale(0.5f), protocol::encode_reset("", std::nullopt)}) {
+    t += std::chrono::seconds(100);  // each within the last one's 120 s: 500 s in all, the sphere kept
+    client.on_frame(use.data(), use.size(), t);
+    CHECK(client.player_idle_deadline() == t + idle);
+  }
+  const auto used = *client.player_idle_deadline();
+  const protocol::Frame ping = protocol::encode_ping(1), still = protocol::encode_player_input(1, {0.0f, 0.0f, 0.0f});
+  client.on_frame(ping.data(), ping.size(), used - std::chrono::seconds(10));
+  client.on_frame(still.data(), still.size(), used - std::chrono::seconds(5));
+  CHECK(client.player_idle_deadline() == used);  // present, but not using the sphere
+}

@@ -204,7 +204,7 @@ def test_a_sphere_freed_for_idleness_takes_control_as_the_servers_policy_does_an
                 assert refused.value.code == "not_permitted"  # the server's answer, not the player_idle before it
             with pytest.raises(FishtankError) as none:
                 idle.move((1, 0, 0))
-            assert none.value.code == "no_player" and "(player_idle: your player sphere did not move" in \
+            assert none.value.code == "no_player" and "(player_idle: your player sphere did not move, and you sent no control" in \
                 none.value.message
 
 
