@@ -168,7 +168,7 @@ class Client:
             place = "next in line" if self.ahead_in_line == 0 else f"in line, {self.ahead_in_line} before it"
             return FishtankError("timeout", f"no player sphere came to this client within {seconds:g} s: it is "
                                  f"{place}, and no sphere was freed (one is when its client leaves, or leaves it "
-                                 "unmoved for the server's --player-idle); give wait_for_player(timeout=) more "
+                                 "unused for the server's --player-idle); give wait_for_player(timeout=) more "
                                  "seconds")
 
         self._wait(holds, time.monotonic() + seconds, no_sphere_came)
