@@ -94,8 +94,8 @@ nlohmann::json time_steps(TunedStepper& stepper, const BenchSpec& spec, const Se
   j["tank"] = {{"min", {tank.min.x, tank.min.y, tank.min.z}}, {"max", {tank.max.x, tank.max.y, tank.max.z}}};
   j["mean_neighbours"] = mean_neighbours(world);
   j["rebuilds"] = world.rebuilds() - rebuilds_before;
-  j["prefetch_ahead"] = world.beyond_cache() && world.kernels().simd != std::string("none");  // --prefetch-from
-  j["skin"] = world.skin();  // at the end (PhysicsParams::skin 0: it follows the motion)
+  j["prefetch_ahead"] = world.beyond_cache();  // --prefetch-from
+  j["skin"] = world.skin();                    // at the end (PhysicsParams::skin 0: it follows the motion)
   // Steps that kept the lists after checking the balls that moved past skin/2.
   j["lists_kept_after_check"] = world.lists_kept_by_checks() - kept_before;
   j["kinetic_energy_per_ball"] = world.ball_count() ? kinetic_energy(world) / world.ball_count() : 0.0;

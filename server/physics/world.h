@@ -117,7 +117,8 @@ class World {
   std::uint64_t rebuilds() const { return rebuilds_; }
   float skin() const { return list_.skin(); }  // the lists' skin now (PhysicsParams::skin)
   // Whether the SIMD step asks for rows ahead (PrefetchPlan): from PhysicsParams::prefetch_from balls.
-  bool beyond_cache() const { return n_ >= params_.prefetch_from; }
+  // The scalar twin (one lane) reads its rows in order and asks for none.
+  bool beyond_cache() const { return kernels_.list_lanes > 1 && n_ >= params_.prefetch_from; }
   // Steps whose lists were kept after checking the balls that strayed more than skin / 2 (lists_hold()).
   std::uint64_t lists_kept_by_checks() const { return lists_kept_by_checks_; }
   // Balls checked in those steps and in the steps whose checks found a contact.
