@@ -327,8 +327,9 @@ export class Connection {
 
   private everySecond(): void {
     const now = seconds();
-    this.snapshotRate.close(now);
-    this.byteRate.close(now);
+    // At least half a second: a window restarted by setVisible just before this tick stays open to the next.
+    this.snapshotRate.close(now, 0.5);
+    this.byteRate.close(now, 0.5);
     this.send(wire.ping(Math.round(now * 1e6) >>> 0));
   }
 }
